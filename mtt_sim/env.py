@@ -1,0 +1,241 @@
+"""TrackingEnv: the Gymnasium face of the simulator.
+
+Each step the agent answers the current observation (frame and detections) with its tracks;
+the environment scores those tracks against the current ground truth, advances the world one
+frame, renders it, runs the detector and returns the next observation.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections import deque
+from typing import Any, Mapping
+
+import cv2
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from . import scenario as scn
+from .overlay import draw_overlay
+from .render import Renderer
+from .sensor import Detections, make_sensor
+from .truth import Truth, measure
+from .world import World
+
+_SPACE_KEYS = ("render.width", "render.height", "sensor.max_detections", "env.max_tracks", "env.obs_mode")
+_TRAIL = 12
+
+
+class ActionError(ValueError):
+    """The agent's action does not describe a valid set of tracks."""
+
+
+class TrackingEnv(gym.Env):
+    """Video multi-target tracking in a simulated scene.
+
+    **Observation** ``Dict(frame=Box(uint8, (H, W, 3)), detections=Box(float32, (max_detections, 5)),
+    num_detections=Discrete(max_detections + 1))``: the RGB video frame (absent with
+    ``obs_mode="detections"``) and the detector's boxes ``x, y, w, h, confidence`` (top-left and size,
+    pixels), padded with zero rows after ``num_detections``.
+
+    **Action** ``Dict(ids=Box(int64, (max_tracks,)), boxes=Box(float32, (max_tracks, 4)),
+    num_tracks=Discrete(max_tracks + 1))``: the tracker's tracks for the frame it was shown (the first
+    ``num_tracks`` rows count). A dict of unpadded ``ids`` (n,) and ``boxes`` (n, 4) is accepted too.
+
+    **Reward** a placeholder 0.0 until the metrics land (``info["reward_note"]`` says so).
+
+    **Episode end** ``terminated`` when no target is alive and none can be born any more;
+    ``truncated`` after ``env.max_steps`` steps.
+
+    **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
+    trackers initialised by hand. ``env.unwrapped.truth`` is the current ground truth.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 25}
+
+    def __init__(self, scenario: str | os.PathLike | scn.Scenario = "crossing", config: Mapping | None = None,
+                 render_mode: str | None = None, obs_mode: str | None = None):
+        overrides = scn.expand_dotted(config or {})
+        if obs_mode is not None:
+            overrides = scn.merge(overrides, {"env": {"obs_mode": obs_mode}})
+        self._source = scenario
+        self.scenario = scn.load(scenario, overrides)
+        self._overrides = overrides
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode={render_mode!r}: allowed values: None, 'rgb_array', 'human'")
+        if render_mode == "human":
+            _require_display()
+        self.render_mode = render_mode
+        self.observation_space, self.action_space = self._spaces(self.scenario)
+        self.world: World | None = None
+        self._done = True
+
+    # ------------------------------------------------------------ spaces
+
+    @staticmethod
+    def _spaces(sc: scn.Scenario):
+        w, h = sc.render.width, sc.render.height
+        nd, nt = sc.sensor.max_detections, sc.env.max_tracks
+        det_high = np.tile(np.array([w, h, w, h, 1], np.float32), (nd, 1))
+        obs = {"detections": spaces.Box(0.0, det_high, (nd, 5), np.float32), "num_detections": spaces.Discrete(nd + 1)}
+        if sc.env.obs_mode == "frame+detections":
+            obs = {"frame": spaces.Box(0, 255, (h, w, 3), np.uint8), **obs}
+        box_low = np.tile(np.array([-w, -h, 1, 1], np.float32), (nt, 1))
+        box_high = np.tile(np.array([2 * w, 2 * h, 2 * w, 2 * h], np.float32), (nt, 1))
+        act = {"ids": spaces.Box(0, 2**31 - 1, (nt,), np.int64), "boxes": spaces.Box(box_low, box_high, (nt, 4), np.float32),
+               "num_tracks": spaces.Discrete(nt + 1)}
+        return spaces.Dict(obs), spaces.Dict(act)
+
+    # ------------------------------------------------------------ episode
+
+    def reset(self, *, seed: int | None = None, options: Mapping | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - {"config"}
+        if unknown:
+            raise ValueError(f"reset options: unknown key(s) {sorted(unknown)}; allowed: 'config'")
+        if "config" in options:
+            self._reconfigure(options["config"])
+        sc = self.scenario
+        world_rng, render_rng, sensor_rng = (np.random.default_rng(s) for s in
+                                            np.random.SeedSequence(self.np_random.integers(2**63)).spawn(3))
+        self.world = World(sc, world_rng)
+        self.renderer = Renderer(sc, render_rng)
+        empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
+        self.sensor = make_sensor(sc, sensor_rng, empty)
+        self.steps = 0
+        self._done = False
+        self._trails: dict[int, deque] = {}
+        self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4), np.float32))
+        obs = self._observe()
+        seen = self.truth.visibility > 0
+        info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy()}
+        return obs, info
+
+    def _reconfigure(self, config: Mapping):
+        overrides = scn.merge(self._overrides, scn.expand_dotted(config))
+        new = scn.load(self._source, overrides)
+        changed = [k for k in _SPACE_KEYS if _get(new, k) != _get(self.scenario, k)]
+        if changed:
+            raise ValueError(f"reset(options={{'config': ...}}) cannot change {', '.join(changed)}: the observation and "
+                             "action spaces are fixed when the env is made; pass them to gym.make(..., config=...) instead")
+        self.scenario = new
+
+    def step(self, action):
+        if self._done:
+            raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
+        ids, boxes = self.validate_action(action)
+        self._remember(ids, boxes)
+        reward = 0.0
+        self.world.step()
+        self.renderer.camera.advance()
+        self.steps += 1
+        obs = self._observe()
+        terminated = bool(self.world.finished)
+        truncated = bool(self.steps >= self.scenario.env.max_steps and not terminated)
+        self._done = terminated or truncated
+        info = {"frame_index": self.steps, "reward_note": "placeholder 0.0: the metrics are not implemented yet"}
+        return obs, float(reward), terminated, truncated, info
+
+    def _observe(self) -> dict[str, Any]:
+        sc = self.scenario
+        want_frame = sc.env.obs_mode == "frame+detections" or sc.sensor.model == "foreground" or self.render_mode
+        frame, labels, boxes = self.renderer.render(self.world, draw_frame=bool(want_frame))
+        w = self.world
+        self.frame, self.labels = frame, labels
+        self.truth: Truth = measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group],
+                                    self.renderer.occluder_boxes - np.r_[self.renderer.camera.offset, 0, 0],
+                                    self.renderer.occluder_depth)
+        self.detections: Detections = self.sensor.detect(self.truth, labels, frame)
+        rows = self.detections.rows
+        padded = np.zeros((sc.sensor.max_detections, 5), np.float32)
+        padded[: len(rows)] = rows
+        obs = {"detections": padded, "num_detections": np.int64(len(rows))}
+        if sc.env.obs_mode == "frame+detections":
+            obs = {"frame": frame, **obs}
+        return obs
+
+    # ------------------------------------------------------------ actions
+
+    def validate_action(self, action) -> tuple[np.ndarray, np.ndarray]:
+        """The action's tracks as (ids int64 (n,), boxes float32 (n, 4)), or an ActionError saying what is wrong."""
+        nt = self.scenario.env.max_tracks
+        if not isinstance(action, Mapping) or not {"ids", "boxes"} <= set(action):
+            raise ActionError("action must be a dict with 'ids' and 'boxes' (and 'num_tracks' when padded), "
+                              f"got {type(action).__name__}" + (f" with keys {sorted(action)}" if isinstance(action, Mapping) else ""))
+        ids, boxes = np.asarray(action["ids"]), np.asarray(action["boxes"])
+        if "num_tracks" in action:
+            n = action["num_tracks"]
+            if not np.issubdtype(np.asarray(n).dtype, np.integer) or np.ndim(n) != 0 or not 0 <= int(n) <= nt:
+                raise ActionError(f"action['num_tracks'] = {n!r}: must be an integer in 0..{nt} (env.max_tracks)")
+            n = int(n)
+            if ids.shape != (nt,) or boxes.shape != (nt, 4):
+                raise ActionError(f"padded action: 'ids' must have shape ({nt},) and 'boxes' ({nt}, 4), got "
+                                  f"{ids.shape} and {boxes.shape}")
+            ids, boxes = ids[:n], boxes[:n]
+        elif ids.ndim != 1 or boxes.shape != (len(ids), 4) or len(ids) > nt:
+            raise ActionError(f"unpadded action: 'ids' must have shape (n,) and 'boxes' (n, 4) with n <= {nt}, got "
+                              f"{ids.shape} and {boxes.shape}")
+        if ids.size and not np.issubdtype(ids.dtype, np.integer):
+            raise ActionError(f"action['ids'] must be integers, got dtype {ids.dtype}")
+        if not np.issubdtype(boxes.dtype, np.number):
+            raise ActionError(f"action['boxes'] must be numbers, got dtype {boxes.dtype}")
+        bad = ~np.isfinite(boxes).all(axis=1)
+        if bad.any():
+            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(bad)[0])} is not finite: {boxes[bad][0].tolist()}")
+        small = (boxes[:, 2] <= 0) | (boxes[:, 3] <= 0)
+        if small.any():
+            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(small)[0])} has a non-positive width or height: "
+                              f"{boxes[small][0].tolist()} (boxes are x, y, w, h)")
+        uniq, counts = np.unique(ids, return_counts=True)
+        if (counts > 1).any():
+            raise ActionError(f"action['ids'] must be unique within a frame; repeated: {uniq[counts > 1].tolist()}")
+        return ids.astype(np.int64), boxes.astype(np.float32)
+
+    def _remember(self, ids, boxes):
+        """Keep the last tracks and short trails of their centres for the overlay."""
+        self._last_tracks = (ids, boxes)
+        centres = boxes[:, :2] + boxes[:, 2:] / 2
+        for i, c in zip(ids.tolist(), centres):
+            self._trails.setdefault(i, deque(maxlen=_TRAIL)).append(c)
+        alive = set(ids.tolist())
+        for i in [k for k in self._trails if k not in alive]:
+            del self._trails[i]
+
+    # ------------------------------------------------------------ rendering
+
+    def render(self):
+        """rgb_array: the frame with ground truth, detections and the last tracks drawn on; human: show it."""
+        if self.world is None:
+            raise RuntimeError("render() needs reset() first")
+        if self.render_mode is None:
+            gym.logger.warn("render() called with render_mode=None; make the env with render_mode='rgb_array'")
+            return None
+        img = draw_overlay(self.frame, self.truth, self.detections.rows, *self._last_tracks, self._trails)
+        if self.render_mode == "human":
+            cv2.imshow("mtt-sim", cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
+            cv2.waitKey(1)
+            return None
+        return img
+
+    def close(self):
+        if self.render_mode == "human":
+            cv2.destroyAllWindows()
+
+
+def _get(sc: scn.Scenario, dotted: str):
+    obj = sc
+    for part in dotted.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+def _require_display():
+    """render_mode='human' needs a display and an OpenCV with a GUI backend; say so plainly when either is missing."""
+    gui = re.search(r"GUI:\s+NONE", cv2.getBuildInformation()) is None
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) or not gui:
+        raise gym.error.DependencyNotInstalled(
+            "render_mode='human' needs a display and an OpenCV build with a GUI (opencv-python-headless has none). "
+            "Use render_mode='rgb_array' and save a video: `mtt-sim run <scenario> --video out.mp4`.")

@@ -1,0 +1,181 @@
+"""The renderer: one video frame and its per-pixel label map, drawn in the same pass with OpenCV.
+
+Targets and occluders are drawn in depth order (standing: by the y of their base; topdown: by
+layer, occluders on top) into an RGB frame and a uint16 label map whose value is the target's
+slot + 1 where that target is visible, 0 elsewhere. Coordinates use OpenCV's fixed-point
+``shift`` so blobs move smoothly by sub-pixel amounts.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from .scenario import TEXTURES, Scenario
+from .world import World
+
+SHIFT = 4
+_ONE = 1 << SHIFT
+
+
+def draw_blob(img: np.ndarray, box, is_rect: bool, value) -> None:
+    """Fill a box's ellipse (or rectangle) on `img`; box is x, y, w, h in `img` pixels."""
+    x, y, w, h = box
+    if is_rect:
+        cv2.rectangle(img, (round(x * _ONE), round(y * _ONE)), (round((x + w - 1) * _ONE), round((y + h - 1) * _ONE)),
+                      value, -1, cv2.LINE_8, SHIFT)
+    else:
+        cv2.ellipse(img, (round((x + w / 2 - 0.5) * _ONE), round((y + h / 2 - 0.5) * _ONE)),
+                    (max(round(w / 2 * _ONE), 1), max(round(h / 2 * _ONE), 1)), 0, 0, 360, value, -1, cv2.LINE_8, SHIFT)
+
+
+class Camera:
+    """Where the image window sits in the world: static, panning back and forth, or shaking by hand."""
+
+    def __init__(self, sc: Scenario, rng: np.random.Generator):
+        r = sc.render
+        self.mode, self.rng = r.camera, rng
+        self.span = np.array(sc.world_size) - (r.width, r.height)
+        self.velocity = np.array(r.pan_speed, float)
+        self.sigma = r.shake
+        self.base = self.span / 2 if self.mode != "pan" else np.zeros(2)
+        self.jitter = np.zeros(2)
+        self.margin = int(math.ceil(4 * self.sigma)) if self.mode == "shake" else 0
+
+    @property
+    def offset(self) -> np.ndarray:
+        """World coordinates of the image's top-left pixel (integer: the background is cropped, not resampled)."""
+        return np.round(self.base + self.jitter)
+
+    def advance(self):
+        if self.mode == "pan":
+            nxt = self.base + self.velocity
+            bounce = (nxt < 0) | (nxt > self.span)
+            self.velocity = np.where(bounce, -self.velocity, self.velocity)
+            self.base = np.clip(nxt, 0, self.span)
+        elif self.mode == "shake":  # AR(1): a handheld camera drifts around its rest position
+            self.jitter = 0.7 * self.jitter + self.rng.normal(0, self.sigma * math.sqrt(1 - 0.49), 2)
+            self.jitter = np.clip(self.jitter, -self.margin, self.margin)
+
+
+class Renderer:
+    """Draws frames and label maps of a World seen through a Camera."""
+
+    def __init__(self, sc: Scenario, rng: np.random.Generator):
+        self.sc, self.rng = sc, rng
+        r = sc.render
+        self.shape = (r.height, r.width)
+        self.camera = Camera(sc, np.random.default_rng(rng.integers(2**63)))
+        self.photometric_seed = int(rng.integers(2**63))
+        self.canvas = self._background()
+        self.noise_bank = [np.round(rng.normal(0, r.noise, self.shape + (3,))).astype(np.int16) for _ in range(4)] \
+            if r.noise > 0 else []
+        self.noise_tile = rng.uniform(-45, 45, (32, 32))
+        occ = sc.occluders
+        self.occluder_boxes = np.array([o.rect for o in occ], float).reshape(-1, 4)
+        self.occluder_depth = (self.occluder_boxes[:, 1] + self.occluder_boxes[:, 3]) if sc.world.projection == "standing" \
+            else np.full(len(occ), np.inf)
+        self.gain = 1.0
+
+    def _background(self) -> np.ndarray:
+        """The static world backdrop, with a margin for a shaking camera."""
+        r = self.sc.render
+        m = self.camera.margin
+        w, h = (int(math.ceil(v)) + 2 * m for v in self.sc.world_size)
+        img = np.empty((h, w, 3), np.uint8)
+        img[:] = r.background_color
+        if r.background in ("noise", "clutter"):
+            low = cv2.resize(self.rng.normal(0, 14, (h // 8 + 1, w // 8 + 1, 3)), (w, h), interpolation=cv2.INTER_CUBIC)
+            fine = self.rng.normal(0, 5, (h, w, 3))
+            img = np.clip(img + low + fine, 0, 255).astype(np.uint8)
+        if r.background == "clutter":
+            colors = np.array([g.color for g in self.sc.groups], float)
+            sizes = np.array([g.size for g in self.sc.groups], float)
+            for _ in range(r.background_blobs):
+                k = self.rng.integers(len(colors))
+                bw, bh = sizes[k] * self.rng.uniform(0.5, 1.5, 2)
+                x, y = self.rng.uniform(0, w), self.rng.uniform(0, h)
+                color = np.clip(colors[k] + self.rng.normal(0, 25, 3), 0, 255)
+                draw_blob(img, (x - bw / 2, y - bh / 2, bw, bh), bool(self.rng.random() < 0.3), color.tolist())
+        return img
+
+    def image_boxes(self, world: World) -> np.ndarray:
+        """Every target's drawn box in image pixels."""
+        boxes = world.boxes()
+        boxes[:, :2] -= self.camera.offset
+        return boxes
+
+    def render(self, world: World, draw_frame: bool = True, show_targets: bool = True):
+        """(frame or None, labels, image boxes) for the world's current state."""
+        h, w = self.shape
+        off = self.camera.offset.astype(int)
+        m = self.camera.margin
+        labels = np.zeros(self.shape, np.uint16)
+        frame = self.canvas[off[1] + m: off[1] + m + h, off[0] + m: off[0] + m + w].copy() if draw_frame else None
+        boxes = self.image_boxes(world)
+        n = len(boxes) if show_targets else 0
+        occ_boxes = self.occluder_boxes - np.r_[off, 0, 0]
+        all_boxes = np.concatenate([boxes[:n], occ_boxes])
+        onscreen = (all_boxes[:, 0] < w) & (all_boxes[:, 1] < h) & (all_boxes[:, 0] + all_boxes[:, 2] > 0) & \
+                   (all_boxes[:, 1] + all_boxes[:, 3] > 0)
+        order = np.argsort(np.concatenate([world.depth()[:n], self.occluder_depth]), kind="stable")
+        is_rect = world.shape_is_rect[world.group]
+        texture = world.texture_of_group[world.group]
+        colors = world.color.tolist()
+        for i in order[onscreen[order]].tolist():
+            if i < n:
+                box = all_boxes[i]
+                draw_blob(labels, box, is_rect[i], i + 1)
+                if frame is not None:
+                    draw_blob(frame, box, is_rect[i], colors[i])
+                    if texture[i]:
+                        self._texture(frame, labels, i, box, texture[i], colors[i])
+            else:
+                o = self.sc.occluders[i - n]
+                draw_blob(labels, all_boxes[i], o.shape == "rect", 0)
+                if frame is not None:
+                    draw_blob(frame, all_boxes[i], o.shape == "rect", o.color)
+        if frame is not None:
+            frame = self._photometric(frame, world.t)
+        return frame, labels, boxes
+
+    def _texture(self, frame, labels, i, box, kind, color):
+        """Paint stripes, checks or noise on target i's visible pixels, fixed to the target so it moves with it."""
+        h, w = self.shape
+        x0, y0 = max(int(box[0]), 0), max(int(box[1]), 0)
+        x1, y1 = min(int(box[0] + box[2]) + 1, w), min(int(box[1] + box[3]) + 1, h)
+        if x1 <= x0 or y1 <= y0:
+            return
+        mine = labels[y0:y1, x0:x1] == i + 1
+        u = (np.arange(x0, x1) - box[0]) / max(box[2], 1)
+        v = (np.arange(y0, y1) - box[1]) / max(box[3], 1)
+        roi = frame[y0:y1, x0:x1]
+        name = TEXTURES[kind]
+        if name == "noise":
+            tile = self.noise_tile[(v * 32).astype(int) % 32][:, (u * 32).astype(int) % 32]
+            roi[mine] = np.clip(np.asarray(color) + tile[mine][:, None], 0, 255)
+            return
+        bands_v = (np.floor(v * 6) % 2).astype(bool)
+        pattern = bands_v[:, None] if name == "stripes" else bands_v[:, None] ^ (np.floor(u * 4) % 2).astype(bool)[None]
+        roi[mine & pattern] = (0.5 * np.asarray(color)).astype(np.uint8)
+
+    def _photometric(self, frame: np.ndarray, t: int) -> np.ndarray:
+        """Blur, global illumination (brightness, drift, flicker) and pixel noise.
+
+        Their randomness is keyed on the frame index, so drawing a frame or not never shifts other random streams.
+        """
+        r = self.sc.render
+        rng = np.random.default_rng((self.photometric_seed, t)) if r.flicker > 0 or self.noise_bank else None
+        if r.blur > 0:
+            frame = cv2.GaussianBlur(frame, (0, 0), r.blur)
+        gain = r.brightness * (1 + r.illumination_drift * math.sin(2 * math.pi * t / r.illumination_period))
+        if r.flicker > 0:
+            gain *= 1 + r.flicker * rng.normal()
+        self.gain = gain
+        if gain != 1.0:
+            frame = cv2.convertScaleAbs(frame, alpha=gain)
+        if self.noise_bank:
+            frame = cv2.add(frame, self.noise_bank[rng.integers(len(self.noise_bank))], dtype=cv2.CV_8U)
+        return frame

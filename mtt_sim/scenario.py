@@ -1,0 +1,455 @@
+"""Scenario configuration: typed, frozen, validated dataclasses loaded from TOML.
+
+Every field carries its meaning, unit and allowed values in ``metadata``; one generic
+validator turns a nested mapping into a :class:`Scenario` and rejects unknown keys, wrong
+types and out-of-range values with a message naming the source, the dotted key, the value
+and what is allowed. The same metadata generates the README's configuration reference.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import typing
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+
+class ConfigError(ValueError):
+    """A scenario file or override is invalid; the message names file, key, value and what is allowed."""
+
+
+def spec(default, doc, unit="", lo=None, hi=None, choices=None):
+    """A dataclass field whose metadata documents and constrains it."""
+    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "choices": choices}
+    if isinstance(default, (list, tuple)) and default and dataclasses.is_dataclass(default[0]):
+        return field(default_factory=lambda: tuple(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+def table(cls, doc):
+    """A nested dataclass field (a TOML table)."""
+    return field(default_factory=cls, metadata={"doc": doc})
+
+
+Color = tuple[int, int, int]
+Rect = tuple[float, float, float, float]
+
+MOTIONS = ("cv", "random_walk", "manoeuvre", "goal", "carried")
+TEXTURES = ("none", "stripes", "checks", "noise")
+
+
+@dataclass(frozen=True)
+class GroupConfig:
+    """One kind of target: its look, its motion model and how many there are."""
+
+    name: str = spec("targets", "group name (other groups refer to it, e.g. as carrier)")
+    count: int = spec(4, "targets placed at reset", "targets", 0, 10000)
+    birth_rate: float = spec(0.0, "Poisson births per frame at the world borders, entering inward", "1/frame", 0.0, 100.0)
+    region: Rect = spec((0.0, 0.0, 1.0, 1.0), "where initial targets are placed: x0, y0, x1, y1 as fractions of the world", "fraction", 0.0, 1.0)
+    shape: str = spec("ellipse", "drawn outline; the physics footprint is a circle (ellipse) or a box (rect)", choices=("ellipse", "rect"))
+    size: tuple[float, float] = spec((24.0, 24.0), "drawn width, height (standing: at the near edge of the image)", "px", 1.0, 2000.0)
+    size_jitter: float = spec(0.1, "relative standard deviation of each target's size", "", 0.0, 0.5)
+    color: Color = spec((200, 60, 60), "base colour, RGB", "", 0, 255)
+    similarity: float = spec(0.0, "0: every target gets a distinct random hue; 1: all share `color` exactly", "", 0.0, 1.0)
+    texture: str = spec("none", "pattern drawn on the target so gradient features exist", choices=TEXTURES)
+    gait: float = spec(0.0, "non-rigid deformation: relative amplitude of the periodic change of the axes", "", 0.0, 0.5)
+    gait_period: float = spec(20.0, "period of the gait", "frames", 2.0, 1000.0)
+    motion: str = spec("cv", "motion model: constant velocity with random acceleration, Brownian random walk, "
+                       "manoeuvres (sudden turns and stops), goal-seeking toward an exit, carried by another target",
+                       choices=MOTIONS)
+    speed: float = spec(2.0, "mean initial speed (random_walk: velocity standard deviation per frame)", "px/frame", 0.0, 200.0)
+    speed_jitter: float = spec(0.2, "relative standard deviation of the initial speed", "", 0.0, 1.0)
+    heading: float = spec(0.0, "mean initial direction of travel, 0 = +x (right), 90 = +y (down)", "deg", -360.0, 360.0)
+    heading_jitter: float = spec(180.0, "half-width of the uniform spread around `heading`; 180 = any direction", "deg", 0.0, 180.0)
+    accel: float = spec(0.05, "standard deviation of the random acceleration (cv, manoeuvre, goal)", "px/frame^2", 0.0, 50.0)
+    max_speed: float = spec(20.0, "speeds are clipped to this", "px/frame", 0.1, 500.0)
+    turn_prob: float = spec(0.02, "manoeuvre: probability per frame of a sudden turn by 60..180 deg", "1/frame", 0.0, 1.0)
+    stop_prob: float = spec(0.01, "manoeuvre: probability per frame of stopping, and of a stopped target starting again x5", "1/frame", 0.0, 1.0)
+    layer: int = spec(0, "topdown: targets on different layers do not collide; higher layers are drawn on top", "", 0, 15)
+    carrier: str = spec("", "carried: name of the group whose targets carry these (one each, pinned by a joint)")
+
+
+@dataclass(frozen=True)
+class DoorConfig:
+    """A place inside the scene where targets appear (entry) or disappear (exit)."""
+
+    rect: Rect = spec((0.0, 0.0, 10.0, 10.0), "x, y, w, h in world coordinates", "px", -1e5, 1e5)
+    role: str = spec("both", "entry: spawns targets; exit: absorbs goal-seeking and passing targets; both", choices=("entry", "exit", "both"))
+    birth_rate: float = spec(0.0, "Poisson births per frame from this door", "1/frame", 0.0, 100.0)
+    group: str = spec("", "group of the targets it spawns (default: the first group)")
+
+
+@dataclass(frozen=True)
+class OccluderConfig:
+    """A static object (pillar, tree, wall) drawn in front of the targets behind it."""
+
+    rect: Rect = spec((0.0, 0.0, 10.0, 10.0), "x, y, w, h in world coordinates", "px", -1e5, 1e5)
+    shape: str = spec("rect", "drawn outline", choices=("rect", "ellipse"))
+    color: Color = spec((90, 90, 90), "RGB", "", 0, 255)
+    solid: bool = spec(False, "targets collide with it (topdown: its area; standing: its base line)")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """The pymunk world: its size, projection, walls, collisions and population limits."""
+
+    projection: str = spec("topdown", "topdown: the image is the world plane; standing: the world is the ground plane "
+                           "and targets are upright blobs that shrink with distance", choices=("topdown", "standing"))
+    size: tuple[float, float] = spec((0.0, 0.0), "world width, height; 0 = the image size (larger for a panning camera)", "px", 0.0, 1e5)
+    walls: bool = spec(False, "targets bounce off the world borders instead of leaving")
+    collision: str = spec("elastic", "target-target contacts: elastic, soft (inelastic) or none", choices=("elastic", "soft", "none"))
+    max_alive: int = spec(1000, "no births while this many targets are alive", "targets", 1, 100000)
+    max_births: int = spec(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
+    far_scale: float = spec(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
+
+
+@dataclass(frozen=True)
+class RenderConfig:
+    """How a frame looks: resolution, background, lighting, noise and camera."""
+
+    width: int = spec(640, "image width", "px", 16, 4096)
+    height: int = spec(480, "image height", "px", 16, 4096)
+    background: str = spec("noise", "flat colour, textured noise, or clutter of target-like blobs", choices=("flat", "noise", "clutter"))
+    background_color: Color = spec((110, 120, 110), "RGB", "", 0, 255)
+    background_blobs: int = spec(40, "clutter background: number of static blobs", "", 0, 10000)
+    brightness: float = spec(1.0, "global gain; below 1 is a dark scene", "", 0.05, 3.0)
+    illumination_drift: float = spec(0.0, "relative amplitude of a slow sinusoidal gain drift", "", 0.0, 0.9)
+    illumination_period: float = spec(200.0, "period of the drift", "frames", 2.0, 1e6)
+    flicker: float = spec(0.0, "standard deviation of a per-frame relative gain jitter", "", 0.0, 0.5)
+    noise: float = spec(0.0, "Gaussian pixel noise standard deviation", "grey levels", 0.0, 100.0)
+    blur: float = spec(0.0, "Gaussian blur sigma (0 = none)", "px", 0.0, 20.0)
+    camera: str = spec("static", "static; pan: sweeps across a larger world; shake: handheld jitter", choices=("static", "pan", "shake"))
+    pan_speed: tuple[float, float] = spec((2.0, 0.0), "pan: camera velocity, reversing at the world's edges", "px/frame", -100.0, 100.0)
+    shake: float = spec(3.0, "shake: standard deviation of the camera offset", "px", 0.0, 100.0)
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0,
+                  clutter_rate=0.0, conf_true=0.95, conf_false=0.3),
+    "dpm": dict(pd=0.8, min_visibility=0.3, box_noise=0.08, box_scale=1.15, fragment_prob=0.03, merge_prob=0.3,
+                clutter_rate=3.0, conf_true=0.6, conf_false=0.35, conf_spread=5.0),
+    "frcnn": dict(pd=0.9, min_visibility=0.25, box_noise=0.04, box_scale=1.0, fragment_prob=0.0, merge_prob=0.15,
+                  clutter_rate=0.5, conf_true=0.9, conf_false=0.45),
+    "sdp": dict(pd=0.93, min_visibility=0.2, box_noise=0.03, box_scale=1.0, fragment_prob=0.0, merge_prob=0.1,
+                clutter_rate=0.3, conf_true=0.92, conf_false=0.4),
+}
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """The simulated detector. Keys given explicitly override the chosen preset's values."""
+
+    model: str = spec("synthetic", "synthetic: from the label map; foreground: background subtraction on the frame",
+                      choices=("synthetic", "foreground"))
+    preset: str = spec("", "fill the keys below from a detector preset (MOT17's public detectors)", choices=("",) + tuple(PRESETS))
+    pd: float = spec(0.95, "detection probability at full visibility", "", 0.0, 1.0)
+    min_visibility: float = spec(0.2, "no detection below this visible fraction; pd rises linearly above it", "", 0.0, 1.0)
+    box_noise: float = spec(0.03, "box jitter standard deviation relative to the box size", "", 0.0, 1.0)
+    box_scale: float = spec(1.0, "systematic box enlargement (loose boxes > 1)", "", 0.5, 2.0)
+    fragment_prob: float = spec(0.02, "probability a visible target is reported as 2-3 fragments "
+                                "(always when an occluder cuts it apart)", "", 0.0, 1.0)
+    merge_prob: float = spec(0.5, "probability targets whose visible regions touch are reported as one box", "", 0.0, 1.0)
+    clutter_rate: float = spec(0.5, "Poisson mean of false detections per frame", "1/frame", 0.0, 1000.0)
+    conf_true: float = spec(0.85, "mean confidence of a fully visible target's detection", "", 0.01, 0.99)
+    conf_false: float = spec(0.35, "mean confidence of a false detection", "", 0.01, 0.99)
+    conf_spread: float = spec(8.0, "Beta concentration of the confidence distributions (higher = tighter)", "", 0.5, 1000.0)
+    min_area: float = spec(20.0, "foreground: smallest blob kept", "px^2", 0.0, 1e6)
+    threshold: float = spec(25.0, "foreground: grey-level difference that counts as foreground", "grey levels", 1.0, 255.0)
+    learning_rate: float = spec(0.02, "foreground: background model update rate on background pixels", "", 0.0, 1.0)
+    max_detections: int = spec(256, "observation rows; extra detections (lowest confidence first) are dropped", "", 1, 100000)
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """The Gym face: episode length, action size and what the observation holds."""
+
+    max_steps: int = spec(300, "episode length; truncated after this many steps", "steps", 1, 10**7)
+    max_tracks: int = spec(256, "rows of the action's padded track arrays", "", 1, 100000)
+    obs_mode: str = spec("frame+detections", "detections: no frame in the observation (no rendering cost beyond the label map)",
+                         choices=("frame+detections", "detections"))
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A named scenario: everything needed to build and run one episode."""
+
+    name: str = spec("Custom", "CamelCase name; the env id is mtt_sim/<name>-v0")
+    description: str = spec("", "one paragraph: what it models and which experiment it mirrors")
+    world: WorldConfig = table(WorldConfig, "the pymunk world")
+    render: RenderConfig = table(RenderConfig, "the frame")
+    sensor: SensorConfig = table(SensorConfig, "the detector")
+    env: EnvConfig = table(EnvConfig, "the Gym face")
+    groups: tuple[GroupConfig, ...] = spec((GroupConfig(),), "target groups ([[groups]] tables)")
+    doors: tuple[DoorConfig, ...] = spec((), "entry/exit doors ([[doors]] tables)")
+    occluders: tuple[OccluderConfig, ...] = spec((), "static occluders ([[occluders]] tables)")
+
+    @property
+    def world_size(self) -> tuple[float, float]:
+        """World width and height in pixels (the image size where `world.size` is 0)."""
+        w, h = self.world.size
+        return (w or float(self.render.width), h or float(self.render.height))
+
+    def group(self, name: str) -> int:
+        """Index of the group called `name`."""
+        names = [g.name for g in self.groups]
+        return names.index(name)
+
+
+# ---------------------------------------------------------------- building from mappings
+
+def _type_name(tp) -> str:
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(value, tp, key: str, meta: Mapping, where: str):
+    """Check `value` against annotation `tp` and the field's range/choices; return the typed value."""
+
+    def fail(allowed: str):
+        raise ConfigError(f"{where}: {key} = {value!r}: {allowed}")
+
+    origin = typing.get_origin(tp)
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, Mapping):
+            fail(f"expected a table of {tp.__name__} keys")
+        return _build(tp, value, where, key + ".")
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            fail(f"expected a list ({_describe(tp)})")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(v, args[0], f"{key}.{i}", meta, where) for i, v in enumerate(value))
+        if len(value) != len(args):
+            fail(f"expected {len(args)} values ({_describe(tp)})")
+        return tuple(_convert(v, a, f"{key}.{i}", meta, where) for i, (v, a) in enumerate(zip(value, args)))
+    if tp is bool:
+        if not isinstance(value, bool):
+            fail("expected true or false")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            fail("expected an integer" + _range_text(meta))
+    elif tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            fail("expected a finite number" + _range_text(meta))
+        value = float(value)
+    elif tp is str:
+        if not isinstance(value, str):
+            fail("expected a string")
+    if meta.get("choices") is not None and value not in meta["choices"]:
+        fail(f"allowed values: {', '.join(repr(c) for c in meta['choices'])}")
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        fail("out of range;" + _range_text(meta))
+    return value
+
+
+def _range_text(meta: Mapping) -> str:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if lo is None and hi is None:
+        return ""
+    return f" allowed: {'-inf' if lo is None else lo} <= value <= {'inf' if hi is None else hi}"
+
+
+def _describe(tp) -> str:
+    if typing.get_origin(tp) is tuple:
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return f"list of {_describe(args[0])}"
+        return f"{len(args)} x {_type_name(args[0])}"
+    return _type_name(tp)
+
+
+_HINTS: dict[type, dict[str, Any]] = {}
+
+
+def _hints(cls) -> dict[str, Any]:
+    if cls not in _HINTS:
+        _HINTS[cls] = typing.get_type_hints(cls)
+    return _HINTS[cls]
+
+
+def _build(cls, raw: Mapping, where: str, prefix: str = ""):
+    """Construct dataclass `cls` from mapping `raw`, validating every key."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(raw) - set(fields))
+    if unknown:
+        raise ConfigError(f"{where}: unknown key {prefix}{unknown[0]}; allowed keys: {', '.join(fields)}")
+    hints = _hints(cls)
+    values = {name: _convert(raw[name], hints[name], prefix + name, fields[name].metadata, where)
+              for name in fields if name in raw}
+    return cls(**values)
+
+
+def _with_preset(raw: Mapping, where: str) -> dict:
+    """Fill sensor keys from the named preset under the explicitly given ones."""
+    raw = dict(raw)
+    sensor = raw.get("sensor")
+    if isinstance(sensor, Mapping) and sensor.get("preset"):
+        if sensor["preset"] not in PRESETS:
+            raise ConfigError(f"{where}: sensor.preset = {sensor['preset']!r}: allowed values: {', '.join(map(repr, PRESETS))}")
+        raw["sensor"] = {**PRESETS[sensor["preset"]], **sensor}
+    return raw
+
+
+def _check_references(sc: Scenario, where: str) -> Scenario:
+    """Cross-field rules that a single field's range cannot express."""
+    names = [g.name for g in sc.groups]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{where}: groups: names must be unique, got {names}")
+    if not sc.groups:
+        raise ConfigError(f"{where}: groups: at least one [[groups]] table is required")
+    for i, g in enumerate(sc.groups):
+        if g.motion == "carried":
+            if g.carrier not in names or g.carrier == g.name:
+                raise ConfigError(f"{where}: groups.{i}.carrier = {g.carrier!r}: must name another group, one of {names}")
+            if g.birth_rate > 0:
+                raise ConfigError(f"{where}: groups.{i}.birth_rate: carried targets are only placed at reset")
+        x0, y0, x1, y1 = g.region
+        if x1 <= x0 or y1 <= y0:
+            raise ConfigError(f"{where}: groups.{i}.region = {g.region}: need x0 < x1 and y0 < y1")
+    for i, d in enumerate(sc.doors):
+        if d.group and d.group not in names:
+            raise ConfigError(f"{where}: doors.{i}.group = {d.group!r}: allowed values: {names}")
+    ww, wh = sc.world_size
+    if ww < sc.render.width or wh < sc.render.height:
+        raise ConfigError(f"{where}: world.size = {sc.world.size}: must be at least the image size "
+                          f"({sc.render.width}, {sc.render.height}) or 0")
+    if sc.sensor.model == "foreground" and sc.render.camera == "pan":
+        raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = 'pan'")
+    return sc
+
+
+def from_mapping(raw: Mapping, where: str = "<config>") -> Scenario:
+    """Build and validate a Scenario from a nested mapping (as read from TOML)."""
+    if not isinstance(raw, Mapping):
+        raise ConfigError(f"{where}: expected a table of scenario keys, got {type(raw).__name__}")
+    raw = _with_preset(raw, where)
+    return _check_references(_build(Scenario, raw, where), where)
+
+
+# ---------------------------------------------------------------- files and overrides
+
+def scenario_dir():
+    """The folder of shipped scenario files (package data `mtt_sim.scenarios`)."""
+    return resources.files("mtt_sim.scenarios")
+
+
+def available() -> dict[str, str]:
+    """Shipped scenario keys (file stems) mapped to the first sentence of their description."""
+    out = {}
+    for entry in sorted(scenario_dir().iterdir(), key=lambda p: p.name):
+        if entry.name.endswith(".toml"):
+            desc = load_raw(entry.name[:-5])[0].get("description", "")
+            out[entry.name[:-5]] = desc.split(". ")[0].strip().rstrip(".")
+    return out
+
+
+def load_raw(key_or_path: str | Path) -> tuple[dict, str]:
+    """Read a scenario's TOML mapping by shipped key or file path; returns (mapping, where)."""
+    path = Path(key_or_path)
+    if path.suffix == ".toml" and path.exists():
+        text, where = path.read_text(), str(path)
+    else:
+        entry = scenario_dir() / f"{key_or_path}.toml"
+        if not entry.is_file():
+            keys = sorted(p.name[:-5] for p in scenario_dir().iterdir() if p.name.endswith(".toml"))
+            raise ConfigError(f"unknown scenario {str(key_or_path)!r}; available: {', '.join(keys)}")
+        text, where = entry.read_text(), f"scenarios/{key_or_path}.toml"
+    try:
+        return tomllib.loads(text), where
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{where}: invalid TOML: {err}") from None
+
+
+def expand_dotted(overrides: Mapping) -> dict:
+    """Turn {"sensor.pd": 0.5} and nested dicts alike into one nested dict."""
+    out: dict = {}
+    for key, value in overrides.items():
+        if not isinstance(key, str):
+            raise ConfigError(f"override keys must be strings, got {key!r}")
+        *parents, leaf = key.split(".")
+        node = out
+        for p in parents:
+            node = node.setdefault(p, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"override {key!r} conflicts with a non-table value at {p!r}")
+        node[leaf] = expand_dotted(value) if isinstance(value, Mapping) else value
+    return out
+
+
+def merge(base: Mapping, overrides: Mapping, prefix: str = "") -> dict:
+    """Recursively merge `overrides` into `base`; list items are addressed by index ("groups.0.count")."""
+    out: Any = dict(base)
+    for key, value in overrides.items():
+        current = out.get(key)
+        if isinstance(current, list) and isinstance(value, Mapping):
+            items = [dict(x) for x in current]
+            for idx, sub in value.items():
+                if not (isinstance(idx, str) and idx.isdigit() and int(idx) < len(items)):
+                    raise ConfigError(f"override {prefix}{key}.{idx}: no such item; {prefix}{key} has {len(items)} entries")
+                items[int(idx)] = merge(items[int(idx)], sub, f"{prefix}{key}.{idx}.")
+            out[key] = items
+        elif isinstance(current, Mapping) and isinstance(value, Mapping):
+            out[key] = merge(current, value, f"{prefix}{key}.")
+        else:
+            out[key] = value
+    return out
+
+
+def to_mapping(obj) -> Any:
+    """A Scenario (or part) as plain nested dicts and lists, the inverse of `from_mapping`."""
+    if dataclasses.is_dataclass(obj):
+        return {f.name: to_mapping(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, tuple):
+        return [to_mapping(x) for x in obj]
+    return obj
+
+
+def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -> Scenario:
+    """Load a shipped scenario (by key), a TOML file or an existing Scenario, with optional overrides."""
+    if isinstance(key_or_path, Scenario):
+        raw, where = to_mapping(key_or_path), f"scenario {key_or_path.name}"
+    else:
+        raw, where = load_raw(key_or_path)
+    if overrides:
+        if not isinstance(overrides, Mapping):
+            raise ConfigError(f"config overrides must be a mapping, got {type(overrides).__name__}")
+        raw = merge(raw, expand_dotted(overrides))
+        where += " (with overrides)"
+    return from_mapping(raw, where)
+
+
+def reference_table() -> str:
+    """Markdown table of every configuration key: key, default, unit, allowed values, meaning."""
+    rows = ["| key | default | unit | allowed | meaning |", "|---|---|---|---|---|"]
+
+    def walk(cls, prefix):
+        hints = _hints(cls)
+        for f in dataclasses.fields(cls):
+            tp, meta = hints[f.name], f.metadata
+            inner = typing.get_args(tp)[0] if typing.get_origin(tp) is tuple else None
+            if dataclasses.is_dataclass(tp):
+                walk(tp, prefix + f.name + ".")
+                continue
+            if inner is not None and dataclasses.is_dataclass(inner):
+                walk(inner, f"{prefix}{f.name}[].")
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            if meta.get("choices"):
+                allowed = ", ".join(repr(c) for c in meta["choices"])
+            else:
+                allowed = _range_text(meta).replace(" allowed: ", "")
+            rows.append(f"| `{prefix}{f.name}` | `{default!r}` | {meta.get('unit', '')} | {allowed} | {meta.get('doc', '')} |")
+
+    walk(Scenario, "")
+    return "\n".join(rows)
+
+
+__all__ = ["Scenario", "GroupConfig", "DoorConfig", "OccluderConfig", "WorldConfig", "RenderConfig", "SensorConfig",
+           "EnvConfig", "ConfigError", "PRESETS", "available", "load", "load_raw", "from_mapping", "to_mapping",
+           "merge", "expand_dotted", "reference_table"]
+

@@ -1,0 +1,354 @@
+"""The pymunk world: targets that move, collide, enter and leave, and static occluders.
+
+Target state lives in numpy arrays (one row per alive target, the "slot"); pymunk only resolves
+contacts and joints. Each step reads every body's position and velocity with ``pymunk.batch``,
+applies the motion models to all targets at once, writes the velocities back and steps the
+space, so no per-target Python object is touched in the steady state.
+
+Coordinates are world pixels, speeds pixels per frame (one frame = one time unit). In the
+``standing`` projection the world is the ground plane and a position is the point between a
+target's feet; sizes and speeds scale with the depth factor of that point, so a target walking
+up the image shrinks and slows down as a real one would.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pymunk
+import pymunk.batch as pbatch
+
+from .scenario import MOTIONS, TEXTURES, Scenario
+
+WALL_BIT = 1 << 31
+_FIELDS = pbatch.BodyFields.BODY_ID | pbatch.BodyFields.POSITION | pbatch.BodyFields.VELOCITY
+_EXIT_MIN_AGE = 10  # frames a target must have lived before an exit door absorbs it (doors with role "both")
+
+
+def hue_colors(hues: np.ndarray) -> np.ndarray:
+    """Saturated RGB colours for hues in [0, 1) (HSV with S = 0.75, V = 0.9)."""
+    h6 = (hues % 1.0) * 6.0
+    k = (np.array([5.0, 3.0, 1.0]) + h6[:, None]) % 6.0
+    rgb = 0.9 * (1 - 0.75 * np.clip(np.minimum(k, 4 - k), 0, 1))
+    return np.round(rgb * 255)
+
+
+class World:
+    """Targets, their motion and their lifecycle for one episode."""
+
+    def __init__(self, scenario: Scenario, rng: np.random.Generator):
+        self.sc = scenario
+        self.rng = rng
+        self.extent = np.array(scenario.world_size)
+        self.standing = scenario.world.projection == "standing"
+        self.t = 0
+        self.next_id = 1
+        self.births = 0
+        self._hue0 = rng.random()
+        self.space = pymunk.Space()
+        self._elasticity = {"elastic": 1.0, "soft": 0.2, "none": 0.0}[scenario.world.collision]
+        self._add_static()
+        self._buf = pbatch.Buffer()
+        n_cols = {"ids": np.int64, "group": np.intp, "pos": (np.float64, 2), "vel": (np.float64, 2),
+                  "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
+                  "goal": (np.float64, 2), "stopped": bool, "born": np.int64}
+        self._cols = list(n_cols)
+        for name, spec_ in n_cols.items():
+            dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
+            setattr(self, name, np.zeros((0, width) if width else 0, dtype))
+        self.bodies: list[pymunk.Body] = []
+        g = scenario.groups
+        self._motion = np.array([MOTIONS.index(x.motion) for x in g])
+        self.texture_of_group = np.array([TEXTURES.index(x.texture) for x in g])
+        self.layer_of_group = np.array([x.layer for x in g])
+        self.shape_is_rect = np.array([x.shape == "rect" for x in g])
+        self._gait = np.array([[x.gait, x.gait_period] for x in g])
+        self._exits = [d for d in scenario.doors if d.role in ("exit", "both")]
+        self._populate()
+        self._sync_order()
+
+    # ------------------------------------------------------------ geometry
+
+    def depth_scale(self, y: np.ndarray) -> np.ndarray:
+        """Size factor of a footprint at world row y: 1 at the bottom, `far_scale` at the top (standing only)."""
+        if not self.standing:
+            return np.ones_like(y)
+        f = self.sc.world.far_scale
+        return f + (1.0 - f) * np.clip(y / self.extent[1], 0.0, 1.0)
+
+    def boxes(self) -> np.ndarray:
+        """Drawn extent of every target, (n, 4) x, y, w, h in world pixels, with the gait applied."""
+        g = self.group
+        amp, period = self._gait[g, 0], self._gait[g, 1]
+        wave = amp * np.sin(2 * math.pi * self.t / period + self.phase)
+        s = self.depth_scale(self.pos[:, 1])
+        w = self.size[:, 0] * s * (1 + wave)
+        h = self.size[:, 1] * s * (1 - 0.5 * wave)
+        x = self.pos[:, 0] - w / 2
+        y = self.pos[:, 1] - (h if self.standing else h / 2)
+        return np.stack([x, y, w, h], axis=1)
+
+    def depth(self) -> np.ndarray:
+        """Drawing order key of every target: larger is nearer the viewer (drawn later)."""
+        if self.standing:
+            return self.pos[:, 1].copy()
+        return self.layer_of_group[self.group] * 1e9 + self.ids.astype(np.float64)
+
+    @property
+    def finished(self) -> bool:
+        """No target alive and no birth can happen any more."""
+        if len(self.ids):
+            return False
+        can_spawn = any(g.birth_rate > 0 for g in self.sc.groups) or any(
+            d.birth_rate > 0 and d.role != "exit" for d in self.sc.doors)
+        cap = self.sc.world.max_births
+        return not can_spawn or (cap >= 0 and self.births >= cap)
+
+    # ------------------------------------------------------------ construction
+
+    def _add_static(self):
+        """Walls at the world borders and the solid occluders, as static shapes."""
+        sb = self.space.static_body
+        shapes = []
+        if self.sc.world.walls:
+            w, h = self.extent
+            corners = [(0, 0), (w, 0), (w, h), (0, h)]
+            shapes += [pymunk.Segment(sb, corners[i], corners[(i + 1) % 4], 2.0) for i in range(4)]
+        for occ in self.sc.occluders:
+            if occ.solid:
+                x, y, w, h = occ.rect
+                if self.standing:  # people walk around the base of a pillar, not through its image
+                    y, h = y + h - max(4.0, 0.1 * h), max(4.0, 0.1 * h)
+                shapes.append(pymunk.Poly(sb, [(x, y), (x + w, y), (x + w, y + h), (x, y + h)]))
+        for s in shapes:
+            s.elasticity, s.friction = 1.0, 0.0
+            s.filter = pymunk.ShapeFilter(categories=WALL_BIT)
+        self.space.add(*shapes)
+
+    def _populate(self):
+        """Place every group's initial targets, carriers before the targets they carry."""
+        order = sorted(range(len(self.sc.groups)), key=lambda i: self.sc.groups[i].motion == "carried")
+        for gi in order:
+            g = self.sc.groups[gi]
+            if g.motion == "carried":
+                carriers = np.flatnonzero(self.group == self.sc.group(g.carrier))
+                for slot in carriers[: g.count]:
+                    jitter = self.rng.normal(0, 0.1, 2) * self.size[slot]
+                    self._spawn(gi, self.pos[slot] + jitter, np.zeros(2), carrier=int(slot))
+                continue
+            x0, y0, x1, y1 = np.array(g.region) * np.tile(self.extent, 2)
+            for _ in range(g.count):
+                self._spawn(gi, self._free_spot(gi, (x0, y0, x1, y1)), self._initial_velocity(g))
+
+    def _free_spot(self, gi: int, region, tries: int = 20) -> np.ndarray:
+        """A point in `region` whose footprint does not overlap a target of the same layer, if one is found."""
+        g = self.sc.groups[gi]
+        radius = 0.5 * max(g.size)
+        same = self.layer_of_group[self.group] == g.layer
+        for _ in range(tries):
+            p = self.rng.uniform(region[:2], region[2:])
+            if not same.any():
+                return p
+            d = np.hypot(*(self.pos[same] - p).T)
+            if (d > radius + 0.5 * self.size[same].max(axis=1)).all():
+                return p
+        return p
+
+    def _initial_velocity(self, g, heading: float | None = None) -> np.ndarray:
+        """Velocity drawn from the group's speed and heading distributions."""
+        if heading is None:
+            heading = math.radians(g.heading) + self.rng.uniform(-1, 1) * math.radians(g.heading_jitter)
+        speed = max(0.0, g.speed * (1 + g.speed_jitter * self.rng.normal()))
+        if g.motion == "random_walk":
+            return self.rng.normal(0, g.speed, 2)
+        return speed * np.array([math.cos(heading), math.sin(heading)])
+
+    def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None):
+        """Add one target of group `gi`: a row in every state array and a pymunk body."""
+        g = self.sc.groups[gi]
+        size = np.array(g.size) * np.exp(g.size_jitter * self.rng.normal(size=2))
+        hue = self._hue0 + 0.618034 * self.next_id
+        color = (1 - g.similarity) * hue_colors(np.array([hue]))[0] + g.similarity * np.array(g.color)
+        row = dict(ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
+                   cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
+                   goal=self._pick_goal(pos), stopped=False, born=self.t)
+        for name in self._cols:
+            setattr(self, name, np.concatenate([getattr(self, name), np.asarray(row[name])[None].astype(getattr(self, name).dtype)]))
+        self.next_id += 1
+        self.bodies.append(self._make_body(g, pos, vel, size, carrier))
+
+    def _make_body(self, g, pos, vel, size, carrier):
+        body = pymunk.Body(1.0, float("inf"))  # no rotation: boxes stay axis-aligned
+        body.position = tuple(pos)
+        body.velocity = tuple(vel * self.depth_scale(np.array([pos[1]]))[0])
+        if self.standing:
+            shape = pymunk.Circle(body, 0.25 * size[0] * self.depth_scale(np.array([pos[1]]))[0])
+        elif g.shape == "rect":
+            shape = pymunk.Poly.create_box(body, tuple(size))
+        else:
+            shape = pymunk.Circle(body, 0.5 * min(size))
+        shape.elasticity, shape.friction = self._elasticity, 0.0
+        bit = 1 << g.layer
+        shape.filter = pymunk.ShapeFilter(categories=bit, mask=WALL_BIT | (0 if self.sc.world.collision == "none" else bit))
+        self.space.add(body, shape)
+        if carrier is not None:
+            joint = pymunk.PivotJoint(self.bodies[carrier], body, tuple(pos))
+            joint.collide_bodies = False
+            self.space.add(joint)
+        return body
+
+    def _pick_goal(self, pos: np.ndarray) -> np.ndarray:
+        """Where a goal-seeking target heads: a random exit door, else the far side of the world."""
+        if self._exits:
+            x, y, w, h = self._exits[self.rng.integers(len(self._exits))].rect
+            return np.array([x + w / 2, y + h / 2])
+        return np.array([self.extent[0] - pos[0], self.rng.uniform(0, self.extent[1])])
+
+    # ------------------------------------------------------------ stepping
+
+    def _sync_order(self):
+        """Map the rows of pymunk's batch order to our slots (needed after every birth or death).
+
+        The batch also visits the static body that holds the walls; `_rows` picks out the target bodies.
+        """
+        self._buf.clear()
+        pbatch.get_space_bodies(self.space, _FIELDS, self._buf)
+        space_ids = np.frombuffer(self._buf.int_buf(), np.int64)
+        slot_ids = np.array([b.id for b in self.bodies], np.int64)
+        order = np.argsort(slot_ids)
+        where = np.searchsorted(slot_ids[order], space_ids).clip(0, max(len(order) - 1, 0))
+        self._rows = np.flatnonzero(slot_ids[order][where] == space_ids) if len(order) else np.zeros(0, np.intp)
+        self._row_slot = order[where[self._rows]]
+
+    def _read_bodies(self) -> np.ndarray:
+        """(rows, 4) position and velocity of every body in pymunk's batch order."""
+        self._buf.clear()
+        pbatch.get_space_bodies(self.space, _FIELDS, self._buf)
+        return np.frombuffer(self._buf.float_buf(), np.float64).reshape(-1, 4).copy()
+
+    def _slot_view(self, data: np.ndarray) -> np.ndarray:
+        out = np.empty((len(self.ids), 4))
+        out[self._row_slot] = data[self._rows]
+        return out
+
+    def step(self):
+        """Advance one frame: motion models, physics, exits and births."""
+        if len(self.ids):
+            data = self._read_bodies()
+            state = self._slot_view(data)
+            self.pos, body_vel = state[:, :2], state[:, 2:]
+            scale = self.depth_scale(self.pos[:, 1])[:, None]
+            self.vel = body_vel / scale
+            self._apply_motion()
+            carried = self._motion[self.group] == MOTIONS.index("carried")
+            vel = data[:, 2:].copy()  # rows that are not targets (the static body) keep their own velocity
+            vel[self._rows] = np.where(carried[:, None], body_vel, self.vel * scale)[self._row_slot]
+            buf = pbatch.Buffer()
+            buf.set_float_buf(vel.ravel())
+            pbatch.set_space_bodies(self.space, pbatch.BodyFields.VELOCITY, buf)
+        self.space.step(1.0)
+        self.t += 1
+        if len(self.ids):
+            self.pos = self._slot_view(self._read_bodies())[:, :2]
+        self._remove(self._leaving())
+        self._spawn_births()
+
+    def _apply_motion(self):
+        """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""
+        n = len(self.ids)
+        groups = self.sc.groups
+        g = self.group
+        motion = self._motion[g]
+        accel = np.array([x.accel for x in groups])[g][:, None]
+        noise = self.rng.normal(size=(n, 2))
+        vel = self.vel + accel * noise
+        is_ = {m: motion == MOTIONS.index(m) for m in MOTIONS}
+        walk_sigma = np.array([x.speed for x in groups])[g][:, None]
+        vel = np.where(is_["random_walk"][:, None], walk_sigma * noise, vel)
+        to_goal = self.goal - self.pos
+        desired = to_goal / np.maximum(np.hypot(*to_goal.T), 1e-9)[:, None] * self.cruise[:, None]
+        vel = np.where(is_["goal"][:, None], vel + 0.1 * (desired - vel), vel)
+        vel = self._manoeuvre(vel, is_["manoeuvre"])
+        speed = np.hypot(*vel.T)
+        vmax = np.array([x.max_speed for x in groups])[g]
+        vel *= np.minimum(1.0, vmax / np.maximum(speed, 1e-12))[:, None]
+        self.vel = vel
+
+    def _manoeuvre(self, vel: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """Sudden turns by 60..180 degrees, stops and restarts for the manoeuvring targets in `mask`."""
+        groups = self.sc.groups
+        turn_p = np.array([x.turn_prob for x in groups])[self.group]
+        stop_p = np.array([x.stop_prob for x in groups])[self.group]
+        u = self.rng.random((3, len(vel)))
+        angle = np.radians(self.rng.uniform(60, 180, len(vel))) * np.where(u[2] < 0.5, -1, 1)
+        turn = mask & (u[0] < turn_p) & ~self.stopped
+        c, s = np.cos(angle), np.sin(angle)
+        turned = np.stack([c * vel[:, 0] - s * vel[:, 1], s * vel[:, 0] + c * vel[:, 1]], axis=1)
+        vel = np.where(turn[:, None], turned, vel)
+        restart = mask & self.stopped & (u[1] < 5 * stop_p)
+        stop = mask & ~self.stopped & (u[1] < stop_p)
+        heading = self.rng.uniform(0, 2 * math.pi, len(vel))
+        vel = np.where(restart[:, None], self.cruise[:, None] * np.stack([np.cos(heading), np.sin(heading)], 1), vel)
+        self.stopped = (self.stopped & ~restart) | stop
+        return np.where(self.stopped[:, None] & mask[:, None], 0.0, vel)
+
+    def _leaving(self) -> np.ndarray:
+        """Slots of targets that left the world (by more than their size) or entered an exit door."""
+        margin = self.size.max(axis=1)[:, None]
+        out = ((self.pos < -margin) | (self.pos > self.extent + margin)).any(axis=1)
+        old = self.t - self.born >= _EXIT_MIN_AGE
+        for d in self._exits:
+            x, y, w, h = d.rect
+            inside = (self.pos[:, 0] >= x) & (self.pos[:, 0] <= x + w) & (self.pos[:, 1] >= y) & (self.pos[:, 1] <= y + h)
+            out |= inside & old
+        return np.flatnonzero(out)
+
+    def _remove(self, slots: np.ndarray):
+        if not len(slots):
+            return
+        keep = np.ones(len(self.ids), bool)
+        keep[slots] = False
+        bodies = [self.bodies[s] for s in slots]
+        joints = {c for b in bodies for c in b.constraints}
+        self.space.remove(*joints, *(s for b in bodies for s in b.shapes), *bodies)
+        self.bodies = [b for b, k in zip(self.bodies, keep) if k]
+        for name in self._cols:
+            setattr(self, name, getattr(self, name)[keep])
+        self._sync_order()
+
+    def _spawn_births(self):
+        """Poisson births at the world borders (per group) and at entry doors."""
+        cap, wcfg = self.sc.world.max_births, self.sc.world
+        before = self.births
+        events = []
+        for gi, g in enumerate(self.sc.groups):
+            events += [(gi, None)] * self.rng.poisson(g.birth_rate)
+        for d in self.sc.doors:
+            if d.role != "exit":
+                gi = self.sc.group(d.group) if d.group else 0
+                events += [(gi, d)] * self.rng.poisson(d.birth_rate)
+        for gi, door in events:
+            if len(self.ids) >= wcfg.max_alive or (cap >= 0 and self.births >= cap):
+                break
+            g = self.sc.groups[gi]
+            if door is None:
+                pos, heading = self._border_entry(g)
+            else:
+                x, y, w, h = door.rect
+                pos = self.rng.uniform((x, y), (x + w, y + h))
+                heading = self.rng.uniform(0, 2 * math.pi)
+            self._spawn(gi, pos, self._initial_velocity(g, heading))
+            self.births += 1
+        if self.births != before:
+            self._sync_order()
+
+    def _border_entry(self, g) -> tuple[np.ndarray, float]:
+        """A point on a random border (just outside it, or just inside where there are walls) and an inward heading."""
+        w, h = self.extent
+        side = self.rng.choice(4, p=np.array([h, w, h, w]) / (2 * (w + h)))
+        inset = 2.0 + 0.5 * max(g.size) if self.sc.world.walls else -0.5 * max(g.size)
+        u = self.rng.random()
+        pos, inward = [((inset, u * h), 0.0), ((u * w, inset), 90.0),
+                       ((w - inset, u * h), 180.0), ((u * w, h - inset), 270.0)][side]
+        return np.array(pos), math.radians(inward + self.rng.uniform(-45, 45))

@@ -1,0 +1,1 @@
+"""Shipped scenario files (TOML), installed as the package data `mtt_sim.scenarios`."""
