@@ -178,7 +178,9 @@ class TrackingEnv(gym.Env):
         elif ids.ndim != 1 or boxes.shape != (len(ids), 4) or len(ids) > nt:
             raise ActionError(f"unpadded action: 'ids' must have shape (n,) and 'boxes' (n, 4) with n <= {nt}, got "
                               f"{ids.shape} and {boxes.shape}")
-        if ids.size and not np.issubdtype(ids.dtype, np.integer):
+        if not ids.size:
+            return np.zeros(0, np.int64), np.zeros((0, 4), np.float32)
+        if not np.issubdtype(ids.dtype, np.integer):
             raise ActionError(f"action['ids'] must be integers, got dtype {ids.dtype}")
         if not np.issubdtype(boxes.dtype, np.number):
             raise ActionError(f"action['boxes'] must be numbers, got dtype {boxes.dtype}")

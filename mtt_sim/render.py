@@ -20,15 +20,32 @@ SHIFT = 4
 _ONE = 1 << SHIFT
 
 
-def draw_blob(img: np.ndarray, box, is_rect: bool, value) -> None:
-    """Fill a box's ellipse (or rectangle) on `img`; box is x, y, w, h in `img` pixels."""
-    x, y, w, h = box
+def fixed_point(boxes: np.ndarray) -> tuple[list, list, list, list]:
+    """OpenCV fixed-point geometry of boxes (n, 4): ellipse centres and axes, rectangle corners, as int lists."""
+    fp = boxes * _ONE
+    half = fp[:, 2:] / 2
+    centre = np.rint(fp[:, :2] + half - _ONE / 2).astype(int).tolist()
+    axes = np.maximum(np.rint(half), 1).astype(int).tolist()
+    p1 = np.rint(fp[:, :2]).astype(int).tolist()
+    p2 = np.rint(fp[:, :2] + fp[:, 2:] - _ONE).astype(int).tolist()
+    return centre, axes, p1, p2
+
+
+def draw_fixed(img: np.ndarray, geometry, i: int, is_rect: bool, value) -> None:
+    """Fill shape i of `fixed_point` geometry on `img`."""
+    centre, axes, p1, p2 = geometry
     if is_rect:
-        cv2.rectangle(img, (round(x * _ONE), round(y * _ONE)), (round((x + w - 1) * _ONE), round((y + h - 1) * _ONE)),
-                      value, -1, cv2.LINE_8, SHIFT)
+        cv2.rectangle(img, p1[i], p2[i], value, -1, cv2.LINE_8, SHIFT)
     else:
-        cv2.ellipse(img, (round((x + w / 2 - 0.5) * _ONE), round((y + h / 2 - 0.5) * _ONE)),
-                    (max(round(w / 2 * _ONE), 1), max(round(h / 2 * _ONE), 1)), 0, 0, 360, value, -1, cv2.LINE_8, SHIFT)
+        cv2.ellipse(img, centre[i], axes[i], 0, 0, 360, value, -1, cv2.LINE_8, SHIFT)
+
+
+def draw_blob(img: np.ndarray, box, is_rect: bool, value) -> None:
+    """Fill one box's ellipse (or rectangle) on `img`; box is x, y, w, h in `img` pixels."""
+    x, y, w, h = (float(v) * _ONE for v in box)
+    geometry = ([(round(x + w / 2 - _ONE / 2), round(y + h / 2 - _ONE / 2))], [(max(round(w / 2), 1), max(round(h / 2), 1))],
+                [(round(x), round(y))], [(round(x + w - _ONE), round(y + h - _ONE))])
+    draw_fixed(img, geometry, 0, is_rect, value)
 
 
 class Camera:
@@ -124,19 +141,19 @@ class Renderer:
         is_rect = world.shape_is_rect[world.group]
         texture = world.texture_of_group[world.group]
         colors = world.color.tolist()
+        geometry = fixed_point(all_boxes)
+        rect = np.concatenate([is_rect[:n], [o.shape == "rect" for o in self.sc.occluders]]).astype(bool).tolist()
         for i in order[onscreen[order]].tolist():
             if i < n:
-                box = all_boxes[i]
-                draw_blob(labels, box, is_rect[i], i + 1)
+                draw_fixed(labels, geometry, i, rect[i], i + 1)
                 if frame is not None:
-                    draw_blob(frame, box, is_rect[i], colors[i])
+                    draw_fixed(frame, geometry, i, rect[i], colors[i])
                     if texture[i]:
-                        self._texture(frame, labels, i, box, texture[i], colors[i])
+                        self._texture(frame, labels, i, all_boxes[i], texture[i], colors[i])
             else:
-                o = self.sc.occluders[i - n]
-                draw_blob(labels, all_boxes[i], o.shape == "rect", 0)
+                draw_fixed(labels, geometry, i, rect[i], 0)
                 if frame is not None:
-                    draw_blob(frame, all_boxes[i], o.shape == "rect", o.color)
+                    draw_fixed(frame, geometry, i, rect[i], self.sc.occluders[i - n].color)
         if frame is not None:
             frame = self._photometric(frame, world.t)
         return frame, labels, boxes

@@ -14,11 +14,9 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from .scenario import Scenario, SensorConfig
-from .truth import Truth, clip_boxes
+from .truth import Truth, clip_boxes, overlapping_pairs
 
 CLUTTER = -1   # source of a false detection
 UNKNOWN = 0    # source of a foreground blob (the image does not say which target made it)
@@ -38,8 +36,7 @@ def detection_probability(visibility: np.ndarray, cfg: SensorConfig) -> np.ndarr
     pd at full view, rising with visibility, none at or below min_visibility, and every visible target when pd = 1.
     """
     ramp = np.clip((visibility - cfg.min_visibility) / max(1e-9, 1 - cfg.min_visibility), 0, 1)
-    with np.errstate(divide="ignore"):
-        return np.where(ramp > 0, cfg.pd ** (1 / np.maximum(ramp, 1e-9)), 0.0)
+    return np.where(ramp > 0, cfg.pd ** (1 / np.maximum(ramp, 1e-9)), 0.0)
 
 
 def _union(boxes: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
@@ -57,6 +54,19 @@ def touching(labels: np.ndarray, la: int, lb: int, box: np.ndarray) -> bool:
     roi = labels[y0:y1, x0:x1]
     a = cv2.dilate((roi == la).astype(np.uint8), np.ones((3, 3), np.uint8))
     return bool(np.any(a.astype(bool) & (roi == lb)))
+
+
+def components(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Connected-component index (0..k-1, by smallest member) of n nodes linked by edges (i, j)."""
+    label = np.arange(n)
+    while len(i):
+        low = np.minimum(label[i], label[j])
+        if (label[i] == low).all() and (label[j] == low).all():
+            break
+        np.minimum.at(label, i, low)
+        np.minimum.at(label, j, low)
+        label = label[label]  # pointer jumping
+    return np.unique(label, return_inverse=True)[1]
 
 
 def _split(box: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
@@ -96,25 +106,28 @@ class Sensor:
     def _clutter(self, truth: Truth) -> np.ndarray:
         """Poisson false boxes, uniformly placed, sized like the current targets."""
         n = self.rng.poisson(self.cfg.clutter_rate)
+        if not n:
+            return np.zeros((0, 4))
         pool = truth.boxes[:, 2:] if len(truth) else self.nominal
         wh = pool[self.rng.integers(len(pool), size=n)] * np.exp(self.rng.normal(0, 0.3, (n, 2)))
         wh = np.minimum(wh, np.array(self.size) * 0.5)
         xy = self.rng.uniform(0, 1, (n, 2)) * (np.array(self.size) - wh)
         return np.concatenate([xy, wh], axis=1)
 
-    def _finish(self, boxes: np.ndarray, conf: np.ndarray, sources: np.ndarray, truth: Truth) -> Detections:
-        """Add clutter, clip to the image, drop degenerate boxes, shuffle, keep at most max_detections (most confident)."""
+    def _finish(self, boxes: np.ndarray, mean_conf: np.ndarray, sources: np.ndarray, truth: Truth) -> Detections:
+        """Add clutter, draw confidences, clip to the image, drop degenerate boxes, shuffle, keep max_detections."""
         cb = self._clutter(truth)
-        boxes = np.concatenate([boxes.reshape(-1, 4), cb])
-        conf = np.concatenate([conf, self._confidence(np.full(len(cb), self.cfg.conf_false))])
-        sources = np.concatenate([sources, np.full(len(cb), CLUTTER)])
+        if len(cb):
+            boxes = np.concatenate([boxes, cb])
+            mean_conf = np.concatenate([mean_conf, np.full(len(cb), self.cfg.conf_false)])
+            sources = np.concatenate([sources, np.full(len(cb), CLUTTER)])
+        conf = self._confidence(mean_conf)
         boxes = clip_boxes(boxes, *self.size)
-        keep = (boxes[:, 2] >= 1) & (boxes[:, 3] >= 1)
-        order = self.rng.permutation(np.flatnonzero(keep))
-        if len(order) > self.cfg.max_detections:
-            best = np.argsort(-conf[order], kind="stable")[: self.cfg.max_detections]
-            order = order[np.sort(best)]
-        rows = np.concatenate([boxes[order], conf[order, None]], axis=1).astype(np.float32)
+        order = self.rng.permutation(np.flatnonzero((boxes[:, 2] >= 1) & (boxes[:, 3] >= 1)))
+        if len(order) > self.cfg.max_detections:  # keep the most confident, in their shuffled order
+            order = order[np.sort(np.argsort(-conf[order], kind="stable")[: self.cfg.max_detections])]
+        rows = np.empty((len(order), 5), np.float32)
+        rows[:, :4], rows[:, 4] = boxes[order], conf[order]
         return Detections(rows, sources[order].astype(np.int64))
 
 
@@ -125,39 +138,40 @@ class SyntheticSensor(Sensor):
         cfg, rng = self.cfg, self.rng
         pd = detection_probability(truth.visibility, cfg)
         cand = np.flatnonzero(pd > 0)
-        groups = self._merge_groups(truth, labels, cand)
-        n_obj = groups.max() + 1 if len(groups) else 0
-        obj_box = _union(truth.visible_boxes[cand], groups, n_obj)
-        obj_pd = np.zeros(n_obj)
-        np.maximum.at(obj_pd, groups, pd[cand])
-        obj_vis = np.zeros(n_obj)
-        np.maximum.at(obj_vis, groups, truth.visibility[cand])
-        size = np.bincount(groups, minlength=n_obj)
-        lead = np.zeros(n_obj, int)  # the member with the largest visible area names the object
-        area = truth.visible_boxes[cand, 2] * truth.visible_boxes[cand, 3]
-        for r in np.argsort(area):
-            lead[groups[r]] = cand[r]
-        hit = rng.random(n_obj) < obj_pd
-        boxes, means, sources = [obj_box], [cfg.conf_true * (0.5 + 0.5 * obj_vis)], [truth.ids[lead]]
-        # fragments replace the whole box of an unmerged detected target
-        split = np.flatnonzero(hit & (size == 1) & ~np.isin(lead, truth.pieces[:, 0].astype(int)))
-        split = split[rng.random(len(split)) < cfg.fragment_prob]
-        cut = np.flatnonzero(hit & (size == 1) & np.isin(lead, truth.pieces[:, 0].astype(int)))
-        for o in cut:
-            p = truth.pieces[truth.pieces[:, 0] == lead[o], 1:]
-            boxes.append(p)
-            means.append(np.full(len(p), 0.8 * means[0][o]))
-            sources.append(np.full(len(p), truth.ids[lead[o]]))
-        for o in split:
-            p = _split(obj_box[o], int(rng.integers(2, 4)), rng)
-            boxes.append(p)
-            means.append(np.full(len(p), 0.8 * means[0][o]))
-            sources.append(np.full(len(p), truth.ids[lead[o]]))
-        whole = hit.copy()
-        whole[np.concatenate([split, cut]).astype(int)] = False
-        boxes[0], means[0], sources[0] = obj_box[whole], means[0][whole], sources[0][whole]
-        b = self._jitter(np.concatenate(boxes)) if cfg.box_noise or cfg.box_scale != 1 else np.concatenate(boxes)
-        return self._finish(b, self._confidence(np.concatenate(means)), np.concatenate(sources), truth)
+        obj = self._merge_groups(truth, labels, cand)
+        n_obj = int(obj.max()) + 1 if len(obj) else 0
+        if n_obj == len(cand):  # nothing merged: one object per candidate target
+            box, p, vis, lead = truth.visible_boxes[cand], pd[cand], truth.visibility[cand], cand
+        else:
+            box = _union(truth.visible_boxes[cand], obj, n_obj)
+            p, vis = np.zeros(n_obj), np.zeros(n_obj)
+            np.maximum.at(p, obj, pd[cand])
+            np.maximum.at(vis, obj, truth.visibility[cand])
+            area = np.prod(truth.visible_boxes[cand, 2:], axis=1)
+            order = np.lexsort((area, obj))  # the member with the largest visible area names the object
+            lead = cand[order[np.r_[np.flatnonzero(np.diff(obj[order])), len(order) - 1]]]
+        single = np.bincount(obj, minlength=n_obj) == 1
+        hit = rng.random(n_obj) < p
+        mean = cfg.conf_true * (0.5 + 0.5 * vis)
+        owners = truth.pieces[:, 0].astype(int)
+        cut = hit & single & np.isin(lead, owners)  # an occluder cut it apart: report its pieces
+        split = hit & single & ~cut & (rng.random(n_obj) < cfg.fragment_prob)
+        whole = hit & ~cut & ~split
+        mean_of = np.zeros(len(truth))
+        mean_of[lead] = mean
+        piece = np.isin(owners, lead[cut])
+        boxes = [box[whole], truth.pieces[piece, 1:]]
+        means = [mean[whole], 0.8 * mean_of[owners[piece]]]
+        sources = [truth.ids[lead[whole]], truth.ids[owners[piece]]]
+        for o in np.flatnonzero(split):
+            parts = _split(box[o], int(rng.integers(2, 4)), rng)
+            boxes.append(parts)
+            means.append(np.full(len(parts), 0.8 * mean[o]))
+            sources.append(np.full(len(parts), truth.ids[lead[o]]))
+        b = np.concatenate(boxes)
+        if cfg.box_noise or cfg.box_scale != 1:
+            b = self._jitter(b)
+        return self._finish(b, np.concatenate(means), np.concatenate(sources), truth)
 
     def _merge_groups(self, truth: Truth, labels: np.ndarray, cand: np.ndarray) -> np.ndarray:
         """Object index of each candidate: targets whose visible regions touch are linked with merge_prob."""
@@ -165,20 +179,19 @@ class SyntheticSensor(Sensor):
         if n < 2 or self.cfg.merge_prob <= 0:
             return np.arange(n)
         vb = truth.visible_boxes[cand]
-        lo, hi = vb[:, :2], vb[:, :2] + vb[:, 2:]
-        near = ((lo[:, None] <= hi[None] + 1) & (lo[None] <= hi[:, None] + 1)).all(axis=2)
-        i, j = np.nonzero(np.triu(near, 1))
+        i, j = overlapping_pairs(vb, margin=1.0)
         linked = self.rng.random(len(i)) < self.cfg.merge_prob
         i, j = i[linked], j[linked]
+        if not len(i):
+            return np.arange(n)
         h, w = labels.shape
-        ok = []
-        for a, b in zip(i, j):
+        lo, hi = vb[:, :2], vb[:, :2] + vb[:, 2:]
+        ok = np.zeros(len(i), bool)
+        for e, (a, b) in enumerate(zip(i.tolist(), j.tolist())):
             x0, y0 = np.maximum(np.minimum(lo[a], lo[b]) - 1, 0).astype(int)
             x1, y1 = np.minimum(np.maximum(hi[a], hi[b]) + 1, (w, h)).astype(int)
-            ok.append(touching(labels, int(truth.labels[cand[a]]), int(truth.labels[cand[b]]), (x0, y0, x1, y1)))
-        ok = np.array(ok, bool)
-        graph = coo_matrix((np.ones(int(ok.sum())), (i[ok], j[ok])), shape=(n, n))
-        return connected_components(graph, directed=False)[1]
+            ok[e] = touching(labels, int(truth.labels[cand[a]]), int(truth.labels[cand[b]]), (x0, y0, x1, y1))
+        return components(n, i[ok], j[ok])
 
 
 class ForegroundSensor(Sensor):
@@ -206,7 +219,7 @@ class ForegroundSensor(Sensor):
         # confidence: strong contrast and a target-sized area make a blob believable
         mean = np.clip(contrast / (4 * cfg.threshold), 0, 1) * (1 - np.exp(-area[keep] / (5 * max(cfg.min_area, 1))))
         boxes = stats[1:][keep, :4].astype(float)
-        return self._finish(boxes, self._confidence(mean), np.full(len(keep), UNKNOWN), truth)
+        return self._finish(boxes, mean, np.full(len(keep), UNKNOWN), truth)
 
 
 def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray) -> Sensor:

@@ -14,9 +14,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .render import draw_blob
-
-_EMPTY4 = np.zeros((0, 4), np.float32)
+from .render import draw_fixed, fixed_point
 
 
 @dataclass(frozen=True)
@@ -38,19 +36,36 @@ class Truth:
 
 def clip_boxes(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Boxes (n, 4) x, y, w, h clipped to the image; fully outside boxes get zero size."""
-    x0 = np.clip(boxes[:, 0], 0, width)
-    y0 = np.clip(boxes[:, 1], 0, height)
-    x1 = np.clip(boxes[:, 0] + boxes[:, 2], 0, width)
-    y1 = np.clip(boxes[:, 1] + boxes[:, 3], 0, height)
-    return np.stack([x0, y0, x1 - x0, y1 - y0], axis=1)
+    corners = np.concatenate([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]], axis=1)
+    np.clip(corners, 0, (width, height, width, height), out=corners)
+    corners[:, 2:] -= corners[:, :2]
+    return corners
+
+
+def overlapping_pairs(boxes: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs (i, j), i != j, each pair once, of boxes x, y, w, h that intersect or come within `margin`.
+
+    Sort and sweep along x, then test y on the candidate pairs: O(n log n + pairs) instead of an n x n matrix.
+    """
+    n = len(boxes)
+    order = np.argsort(boxes[:, 0], kind="stable")
+    b = boxes[order]
+    end = np.searchsorted(b[:, 0], b[:, 0] + b[:, 2] + margin, side="left")
+    counts = np.maximum(end - np.arange(n) - 1, 0)
+    k = np.repeat(np.arange(n), counts)
+    l = k + 1 + np.arange(len(k)) - np.repeat(np.cumsum(counts) - counts, counts)
+    ok = (b[k, 1] < b[l, 1] + b[l, 3] + margin) & (b[l, 1] < b[k, 1] + b[k, 3] + margin)
+    return order[k[ok]], order[l[ok]]
 
 
 def _covered(boxes: np.ndarray, depth: np.ndarray, over_boxes: np.ndarray, over_depth: np.ndarray) -> np.ndarray:
-    """Which boxes intersect a box drawn after them (greater depth)."""
-    a0, a1 = boxes[:, None, :2], boxes[:, None, :2] + boxes[:, None, 2:]
-    b0, b1 = over_boxes[None, :, :2], over_boxes[None, :, :2] + over_boxes[None, :, 2:]
-    overlap = ((a0 < b1) & (b0 < a1)).all(axis=2)
-    return (overlap & (over_depth[None, :] > depth[:, None])).any(axis=1)
+    """Which of `boxes` intersect another of `boxes`, or one of `over_boxes`, drawn after them (greater depth)."""
+    i, j = overlapping_pairs(np.concatenate([boxes, over_boxes]))
+    d = np.concatenate([depth, over_depth])
+    lower = np.where(d[i] < d[j], i, np.where(d[j] < d[i], j, -1))
+    covered = np.zeros(len(d) + 1, bool)
+    covered[lower] = True
+    return covered[: len(boxes)]
 
 
 def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.ndarray, is_rect: np.ndarray,
@@ -64,17 +79,19 @@ def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.nd
     visibility = np.ones(n, np.float32)
     visible = clipped.astype(np.float32)
     truncated = (clipped[:, 2] < boxes[:, 2] - 1e-9) | (clipped[:, 3] < boxes[:, 3] - 1e-9)
-    over_boxes = np.concatenate([boxes, occluder_boxes])
-    over_depth = np.concatenate([depth, occluder_depth])
-    suspects = np.flatnonzero(truncated | _covered(boxes, depth, over_boxes, over_depth))
+    suspects = np.flatnonzero(truncated | _covered(boxes, depth, occluder_boxes, occluder_depth))
+    lo = clipped[suspects, :2].astype(int)
+    hi = np.minimum(np.ceil(clipped[suspects, :2] + clipped[suspects, 2:]).astype(int) + 1, (w, h))
+    local = boxes[suspects].copy()
+    local[:, :2] -= lo  # each suspect's shape in its own region of interest
+    geometry = fixed_point(local)
+    rect = is_rect[inside[suspects]].tolist()
     pieces = []
-    for r in suspects:
-        x0, y0 = int(clipped[r, 0]), int(clipped[r, 1])
-        x1, y1 = min(int(np.ceil(clipped[r, 0] + clipped[r, 2])) + 1, w), min(int(np.ceil(clipped[r, 1] + clipped[r, 3])) + 1, h)
+    for k, (r, (x0, y0), (x1, y1)) in enumerate(zip(suspects.tolist(), lo.tolist(), hi.tolist())):
         mine = cv2.compare(labels[y0:y1, x0:x1], int(inside[r] + 1), cv2.CMP_EQ)
         seen = cv2.countNonZero(mine)
-        alone = np.zeros_like(mine)
-        draw_blob(alone, (boxes[r, 0] - x0, boxes[r, 1] - y0, boxes[r, 2], boxes[r, 3]), bool(is_rect[inside[r]]), 255)
+        alone = np.zeros(mine.shape, np.uint8)
+        draw_fixed(alone, geometry, k, rect[k], 255)
         full = cv2.countNonZero(alone)
         visibility[r] = min(1.0, seen / full) if full else 0.0
         if not seen:
@@ -82,6 +99,8 @@ def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.nd
             continue
         bx, by, bw, bh = cv2.boundingRect(mine)
         visible[r] = (x0 + bx, y0 + by, bw, bh)
+        if seen >= full:
+            continue
         count, _, stats, _ = cv2.connectedComponentsWithStats(mine, connectivity=8)
         big = stats[1:, cv2.CC_STAT_AREA] >= max(4, 0.05 * seen)
         if count > 2 and big.sum() >= 2:
@@ -91,9 +110,3 @@ def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.nd
                  visible_boxes=visible.astype(np.float32), depth=depth.astype(np.float32),
                  labels=inside + 1, pieces=np.concatenate(pieces).astype(np.float32) if pieces else np.zeros((0, 5), np.float32))
 
-
-def empty() -> Truth:
-    """Truth of a frame with no target."""
-    z = np.zeros(0)
-    return Truth(z.astype(np.int64), _EMPTY4, z.astype(np.float32), _EMPTY4, z.astype(np.float32), z.astype(int),
-                 np.zeros((0, 5), np.float32))

@@ -60,10 +60,13 @@ class World:
         self.bodies: list[pymunk.Body] = []
         g = scenario.groups
         self._motion = np.array([MOTIONS.index(x.motion) for x in g])
+        self._present_motions = {x.motion for x in g}
         self.texture_of_group = np.array([TEXTURES.index(x.texture) for x in g])
         self.layer_of_group = np.array([x.layer for x in g])
         self.shape_is_rect = np.array([x.shape == "rect" for x in g])
         self._gait = np.array([[x.gait, x.gait_period] for x in g])
+        self._param = {k: np.array([getattr(x, k) for x in g], float)
+                       for k in ("accel", "speed", "max_speed", "turn_prob", "stop_prob")}
         self._exits = [d for d in scenario.doors if d.role in ("exit", "both")]
         self._populate()
         self._sync_order()
@@ -79,12 +82,12 @@ class World:
 
     def boxes(self) -> np.ndarray:
         """Drawn extent of every target, (n, 4) x, y, w, h in world pixels, with the gait applied."""
-        g = self.group
-        amp, period = self._gait[g, 0], self._gait[g, 1]
-        wave = amp * np.sin(2 * math.pi * self.t / period + self.phase)
         s = self.depth_scale(self.pos[:, 1])
-        w = self.size[:, 0] * s * (1 + wave)
-        h = self.size[:, 1] * s * (1 - 0.5 * wave)
+        w, h = self.size[:, 0] * s, self.size[:, 1] * s
+        if self._gait[:, 0].any():
+            amp, period = self._gait[self.group].T
+            wave = amp * np.sin(2 * math.pi * self.t / period + self.phase)
+            w, h = w * (1 + wave), h * (1 - 0.5 * wave)
         x = self.pos[:, 0] - w / 2
         y = self.pos[:, 1] - (h if self.standing else h / 2)
         return np.stack([x, y, w, h], axis=1)
@@ -256,30 +259,27 @@ class World:
 
     def _apply_motion(self):
         """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""
-        n = len(self.ids)
-        groups = self.sc.groups
-        g = self.group
+        g, p = self.group, self._param
         motion = self._motion[g]
-        accel = np.array([x.accel for x in groups])[g][:, None]
-        noise = self.rng.normal(size=(n, 2))
-        vel = self.vel + accel * noise
-        is_ = {m: motion == MOTIONS.index(m) for m in MOTIONS}
-        walk_sigma = np.array([x.speed for x in groups])[g][:, None]
-        vel = np.where(is_["random_walk"][:, None], walk_sigma * noise, vel)
-        to_goal = self.goal - self.pos
-        desired = to_goal / np.maximum(np.hypot(*to_goal.T), 1e-9)[:, None] * self.cruise[:, None]
-        vel = np.where(is_["goal"][:, None], vel + 0.1 * (desired - vel), vel)
-        vel = self._manoeuvre(vel, is_["manoeuvre"])
+        noise = self.rng.normal(size=(len(g), 2))
+        vel = self.vel + p["accel"][g][:, None] * noise
+        present = self._present_motions
+        if "random_walk" in present:
+            walk = (motion == MOTIONS.index("random_walk"))[:, None]
+            vel = np.where(walk, p["speed"][g][:, None] * noise, vel)
+        if "goal" in present:
+            to_goal = self.goal - self.pos
+            desired = to_goal / np.maximum(np.hypot(*to_goal.T), 1e-9)[:, None] * self.cruise[:, None]
+            vel = np.where((motion == MOTIONS.index("goal"))[:, None], vel + 0.1 * (desired - vel), vel)
+        if "manoeuvre" in present:
+            vel = self._manoeuvre(vel, motion == MOTIONS.index("manoeuvre"))
         speed = np.hypot(*vel.T)
-        vmax = np.array([x.max_speed for x in groups])[g]
-        vel *= np.minimum(1.0, vmax / np.maximum(speed, 1e-12))[:, None]
+        vel *= np.minimum(1.0, p["max_speed"][g] / np.maximum(speed, 1e-12))[:, None]
         self.vel = vel
 
     def _manoeuvre(self, vel: np.ndarray, mask: np.ndarray) -> np.ndarray:
         """Sudden turns by 60..180 degrees, stops and restarts for the manoeuvring targets in `mask`."""
-        groups = self.sc.groups
-        turn_p = np.array([x.turn_prob for x in groups])[self.group]
-        stop_p = np.array([x.stop_prob for x in groups])[self.group]
+        turn_p, stop_p = self._param["turn_prob"][self.group], self._param["stop_prob"][self.group]
         u = self.rng.random((3, len(vel)))
         angle = np.radians(self.rng.uniform(60, 180, len(vel))) * np.where(u[2] < 0.5, -1, 1)
         turn = mask & (u[0] < turn_p) & ~self.stopped
