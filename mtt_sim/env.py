@@ -109,7 +109,7 @@ class TrackingEnv(gym.Env):
         self._done = False
         self._trails: dict[int, deque] = {}
         self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4), np.float32))
-        obs = self._observe()
+        obs = self.observe()
         seen = self.truth.visibility > 0
         info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy()}
         return obs, info
@@ -132,14 +132,15 @@ class TrackingEnv(gym.Env):
         self.world.step()
         self.renderer.camera.advance()
         self.steps += 1
-        obs = self._observe()
+        obs = self.observe()
         terminated = bool(self.world.finished)
         truncated = bool(self.steps >= self.scenario.env.max_steps and not terminated)
         self._done = terminated or truncated
         info = {"frame_index": self.steps, "reward_note": "placeholder 0.0: the metrics are not implemented yet"}
         return obs, float(reward), terminated, truncated, info
 
-    def _observe(self) -> dict[str, Any]:
+    def observe(self) -> dict[str, Any]:
+        """Render, measure the truth and detect for the world as it is now (after reset/step, or after `world.place`)."""
         sc = self.scenario
         want_frame = sc.env.obs_mode == "frame+detections" or sc.sensor.model == "foreground" or self.render_mode
         frame, labels, boxes = self.renderer.render(self.world, draw_frame=bool(want_frame))

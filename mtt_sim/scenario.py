@@ -334,8 +334,11 @@ def from_mapping(raw: Mapping, where: str = "<config>") -> Scenario:
 # ---------------------------------------------------------------- files and overrides
 
 def scenario_dir():
-    """The folder of shipped scenario files (package data `mtt_sim.scenarios`)."""
-    return resources.files("mtt_sim.scenarios")
+    """The folder of shipped scenario files: package data `mtt_sim.scenarios`, or `scenarios/` in a source checkout."""
+    try:
+        return resources.files("mtt_sim.scenarios")
+    except ModuleNotFoundError:
+        return Path(__file__).resolve().parent.parent / "scenarios"
 
 
 def available() -> dict[str, str]:
@@ -418,7 +421,10 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
     if overrides:
         if not isinstance(overrides, Mapping):
             raise ConfigError(f"config overrides must be a mapping, got {type(overrides).__name__}")
-        raw = merge(raw, expand_dotted(overrides))
+        try:
+            raw = merge(raw, expand_dotted(overrides))
+        except ConfigError as err:
+            raise ConfigError(f"{where}: {err}") from None
         where += " (with overrides)"
     return from_mapping(raw, where)
 

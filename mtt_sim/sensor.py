@@ -98,9 +98,9 @@ class Sensor:
 
     def _jitter(self, boxes: np.ndarray) -> np.ndarray:
         """Centre noise and size noise proportional to the box size, and the systematic scale."""
-        s, n = self.cfg.box_noise, len(boxes)
-        c = boxes[:, :2] + boxes[:, 2:] / 2 + self.rng.normal(0, s, (n, 2)) * boxes[:, 2:]
-        wh = boxes[:, 2:] * self.cfg.box_scale * np.exp(self.rng.normal(0, s, (n, 2)))
+        noise = self.rng.normal(0, self.cfg.box_noise, (len(boxes), 4))
+        c = boxes[:, :2] + boxes[:, 2:] / 2 + noise[:, :2] * boxes[:, 2:]
+        wh = boxes[:, 2:] * self.cfg.box_scale * np.exp(noise[:, 2:])
         return np.concatenate([c - wh / 2, wh], axis=1)
 
     def _clutter(self, truth: Truth) -> np.ndarray:
@@ -154,12 +154,12 @@ class SyntheticSensor(Sensor):
         hit = rng.random(n_obj) < p
         mean = cfg.conf_true * (0.5 + 0.5 * vis)
         owners = truth.pieces[:, 0].astype(int)
-        cut = hit & single & np.isin(lead, owners)  # an occluder cut it apart: report its pieces
+        cut = hit & single & np.isin(lead, owners) if len(owners) else np.zeros(n_obj, bool)  # cut apart: report pieces
         split = hit & single & ~cut & (rng.random(n_obj) < cfg.fragment_prob)
         whole = hit & ~cut & ~split
         mean_of = np.zeros(len(truth))
         mean_of[lead] = mean
-        piece = np.isin(owners, lead[cut])
+        piece = np.isin(owners, lead[cut]) if len(owners) else np.zeros(0, bool)
         boxes = [box[whole], truth.pieces[piece, 1:]]
         means = [mean[whole], 0.8 * mean_of[owners[piece]]]
         sources = [truth.ids[lead[whole]], truth.ids[owners[piece]]]

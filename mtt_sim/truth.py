@@ -36,6 +36,7 @@ class Truth:
 
 def clip_boxes(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Boxes (n, 4) x, y, w, h clipped to the image; fully outside boxes get zero size."""
+    boxes = np.asarray(boxes, np.float64)  # float32 corners would round x + w
     corners = np.concatenate([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]], axis=1)
     np.clip(corners, 0, (width, height, width, height), out=corners)
     corners[:, 2:] -= corners[:, :2]

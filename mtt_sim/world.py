@@ -23,6 +23,7 @@ from .scenario import MOTIONS, TEXTURES, Scenario
 
 WALL_BIT = 1 << 31
 _FIELDS = pbatch.BodyFields.BODY_ID | pbatch.BodyFields.POSITION | pbatch.BodyFields.VELOCITY
+_WALL = 200.0  # wall thickness, px
 _EXIT_MIN_AGE = 10  # frames a target must have lived before an exit door absorbs it (doors with role "both")
 
 
@@ -52,7 +53,7 @@ class World:
         self._buf = pbatch.Buffer()
         n_cols = {"ids": np.int64, "group": np.intp, "pos": (np.float64, 2), "vel": (np.float64, 2),
                   "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
-                  "goal": (np.float64, 2), "stopped": bool, "born": np.int64}
+                  "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64}
         self._cols = list(n_cols)
         for name, spec_ in n_cols.items():
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
@@ -114,10 +115,10 @@ class World:
         """Walls at the world borders and the solid occluders, as static shapes."""
         sb = self.space.static_body
         shapes = []
-        if self.sc.world.walls:
-            w, h = self.extent
-            corners = [(0, 0), (w, 0), (w, h), (0, h)]
-            shapes += [pymunk.Segment(sb, corners[i], corners[(i + 1) % 4], 2.0) for i in range(4)]
+        if self.sc.world.walls:  # thick slabs just outside the world, so fast bodies cannot tunnel through
+            w, h, t = *self.extent, _WALL
+            slabs = [(-t, -t, w + t, 0), (-t, h, w + t, h + t), (-t, 0, 0, h), (w, 0, w + t, h)]
+            shapes += [pymunk.Poly(sb, [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]) for x0, y0, x1, y1 in slabs]
         for occ in self.sc.occluders:
             if occ.solid:
                 x, y, w, h = occ.rect
@@ -175,7 +176,8 @@ class World:
         color = (1 - g.similarity) * hue_colors(np.array([hue]))[0] + g.similarity * np.array(g.color)
         row = dict(ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
                    cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
-                   goal=self._pick_goal(pos), stopped=False, born=self.t)
+                   goal=self._pick_goal(pos), stopped=False, born=self.t,
+                   carrier_id=0 if carrier is None else int(self.ids[carrier]))
         for name in self._cols:
             setattr(self, name, np.concatenate([getattr(self, name), np.asarray(row[name])[None].astype(getattr(self, name).dtype)]))
         self.next_id += 1
@@ -193,7 +195,11 @@ class World:
             shape = pymunk.Circle(body, 0.5 * min(size))
         shape.elasticity, shape.friction = self._elasticity, 0.0
         bit = 1 << g.layer
-        shape.filter = pymunk.ShapeFilter(categories=bit, mask=WALL_BIT | (0 if self.sc.world.collision == "none" else bit))
+        if carrier is not None:  # it rides on its carrier and touches nothing else
+            mask = 0
+        else:
+            mask = WALL_BIT | (0 if self.sc.world.collision == "none" else bit)
+        shape.filter = pymunk.ShapeFilter(categories=bit, mask=mask)
         self.space.add(body, shape)
         if carrier is not None:
             joint = pymunk.PivotJoint(self.bodies[carrier], body, tuple(pos))
@@ -207,6 +213,16 @@ class World:
             x, y, w, h = self._exits[self.rng.integers(len(self._exits))].rect
             return np.array([x + w / 2, y + h / 2])
         return np.array([self.extent[0] - pos[0], self.rng.uniform(0, self.extent[1])])
+
+    def place(self, positions: np.ndarray, velocities: np.ndarray | None = None):
+        """Teleport every target to `positions` (n, 2), optionally with new `velocities`; for tests and demos."""
+        positions = np.asarray(positions, float).reshape(len(self.ids), 2)
+        self.pos = positions.copy()
+        if velocities is not None:
+            self.vel = np.asarray(velocities, float).reshape(len(self.ids), 2).copy()
+        body_vel = self.vel * self.depth_scale(self.pos[:, 1])[:, None]
+        for body, p, v in zip(self.bodies, self.pos.tolist(), body_vel.tolist()):
+            body.position, body.velocity = p, v
 
     # ------------------------------------------------------------ stepping
 
@@ -244,9 +260,9 @@ class World:
             scale = self.depth_scale(self.pos[:, 1])[:, None]
             self.vel = body_vel / scale
             self._apply_motion()
-            carried = self._motion[self.group] == MOTIONS.index("carried")
+            out = self._carry(self.vel * scale, body_vel)
             vel = data[:, 2:].copy()  # rows that are not targets (the static body) keep their own velocity
-            vel[self._rows] = np.where(carried[:, None], body_vel, self.vel * scale)[self._row_slot]
+            vel[self._rows] = out[self._row_slot]
             buf = pbatch.Buffer()
             buf.set_float_buf(vel.ravel())
             pbatch.set_space_bodies(self.space, pbatch.BodyFields.VELOCITY, buf)
@@ -256,6 +272,17 @@ class World:
             self.pos = self._slot_view(self._read_bodies())[:, :2]
         self._remove(self._leaving())
         self._spawn_births()
+
+    def _carry(self, out: np.ndarray, body_vel: np.ndarray) -> np.ndarray:
+        """Carried targets move with their carrier's new velocity (chipmunk integrates positions before it solves
+        joints, so the pivot joint alone would lag one frame); a carried target whose carrier died drifts on."""
+        carried = np.flatnonzero(self.carrier_id)
+        if len(carried):
+            slot = np.searchsorted(self.ids, self.carrier_id[carried]).clip(0, len(self.ids) - 1)
+            alive = self.ids[slot] == self.carrier_id[carried]
+            out[carried] = np.where(alive[:, None], out[slot], body_vel[carried])
+            self.vel[carried] = np.where(alive[:, None], self.vel[slot], self.vel[carried])
+        return out
 
     def _apply_motion(self):
         """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""

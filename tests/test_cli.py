@@ -1,0 +1,60 @@
+"""The mtt-sim command."""
+
+import json
+import subprocess
+import sys
+
+import cv2
+import pytest
+
+from mtt_sim import cli, perf
+
+
+def mtt_sim(*args):
+    return subprocess.run([sys.executable, "-m", "mtt_sim.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_list_names_every_scenario_with_its_env_id():
+    out = mtt_sim("list")
+    assert out.returncode == 0
+    assert "crossing" in out.stdout and "mtt_sim/Crossing-v0" in out.stdout and len(out.stdout.splitlines()) >= 8
+
+
+def test_run_prints_a_summary_and_writes_a_video(tmp_path, capsys):
+    video = tmp_path / "out.mp4"
+    assert cli.main(["run", "crossing", "--seed", "0", "--steps", "30", "--video", str(video),
+                     "--config", "sensor.clutter_rate=2"]) == 0
+    text = capsys.readouterr().out
+    assert "echoes each frame's detections" in text and "detector_recall" in text
+    cap = cv2.VideoCapture(str(video))
+    assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 30 and int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)) == 384
+
+
+def test_run_json_is_deterministic(capsys):
+    cli.main(["run", "clutter_storm", "--steps", "20", "--json"])
+    first = capsys.readouterr().out
+    cli.main(["run", "clutter_storm", "--steps", "20", "--json"])
+    assert json.loads(first) == json.loads(capsys.readouterr().out)
+    assert json.loads(first)["frames"] == 20
+
+
+def test_errors_are_one_line_with_exit_code_two():
+    out = mtt_sim("run", "nowhere")
+    assert out.returncode == 2 and out.stderr.startswith("mtt-sim: error: unknown scenario 'nowhere'")
+    out = mtt_sim("run", "crossing", "--config", "sensor.pd=2")
+    assert out.returncode == 2 and "sensor.pd = 2" in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.parametrize("text, value", [("sensor.pd=0.5", 0.5), ("render.camera=shake", "shake"),
+                                         ("world.walls=true", True), ("groups.0.size=[10, 20]", [10, 20])])
+def test_config_values_are_read_as_toml(text, value):
+    assert cli.parse_overrides([text]) == {text.split("=")[0]: value}
+
+
+def test_config_reference_and_perf_report_shape(capsys):
+    assert cli.main(["config"]) == 0
+    assert "| `sensor.clutter_rate` |" in capsys.readouterr().out
+    rows = perf.measure(repeats=1, steps=4)
+    assert [r["targets"] for r in rows] == [20, 200]
+    assert all(r["frames_steps_per_s"] > 0 and r["step_over_reference"] > 0 for r in rows)
+    assert "step / reference" in perf.report(rows)

@@ -1,0 +1,165 @@
+"""The Gym face: registration, checker, determinism, vector envs, action validation, episode ends."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import mtt_sim
+from helpers import still, tiny
+from mtt_sim import ActionError, ConfigError, TrackingEnv
+
+ENV_IDS = sorted(mtt_sim.env_ids().values())
+NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4), np.float32)}
+
+
+def echo(obs):
+    n = int(obs["num_detections"])
+    return {"ids": np.arange(n), "boxes": obs["detections"][:n, :4]}
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_check_env_passes(env_id):
+    env = gym.make(env_id)
+    check_env(env.unwrapped, skip_render_check=True)
+
+
+def test_every_scenario_has_one_env_id():
+    assert len(ENV_IDS) == len(mtt_sim.available()) >= 8
+    assert "mtt_sim/Crossing-v0" in ENV_IDS
+
+
+def test_the_readme_example_runs():
+    env = gym.make("mtt_sim/Crossing-v0", render_mode="rgb_array", config={"sensor": {"clutter_rate": 5}})
+    obs, info = env.reset(seed=0)
+    assert obs["frame"].shape == (288, 384, 3) and obs["frame"].dtype == np.uint8
+    dets = obs["detections"][: obs["num_detections"]]
+    assert dets.dtype == np.float32 and dets.shape[1] == 5
+    assert (obs["detections"][obs["num_detections"]:] == 0).all()
+    obs, reward, terminated, truncated, info = env.step(echo(obs))
+    assert type(terminated) is bool and type(truncated) is bool and isinstance(reward, float)
+    img = env.render()
+    assert img.shape == (288, 384, 3) and not np.array_equal(img, obs["frame"])
+
+
+def rollout(env_id, seed, steps=100, **kwargs):
+    env = gym.make(env_id, **kwargs)
+    obs, _ = env.reset(seed=seed)
+    out = []
+    for _ in range(steps):
+        obs, reward, term, trunc, _ = env.step(echo(obs))
+        out.append((obs.get("frame", np.zeros(0)).tobytes(), obs["detections"].tobytes(), reward))
+        if term or trunc:
+            break
+    return out
+
+
+@pytest.mark.parametrize("env_id", ["mtt_sim/Crossing-v0", "mtt_sim/Mot17Like-v0", "mtt_sim/Umbrellas-v0"])
+def test_same_seed_is_byte_identical_and_seeds_differ(env_id):
+    a, b = rollout(env_id, 7), rollout(env_id, 7)
+    assert a == b and len(a) == 100
+    assert rollout(env_id, 8, steps=5) != a[:5]
+
+
+def test_detections_mode_sees_the_same_world_without_frames():
+    env_f = gym.make("mtt_sim/Mot17Like-v0")
+    env_d = gym.make("mtt_sim/Mot17Like-v0", obs_mode="detections")
+    of, _ = env_f.reset(seed=1)
+    od, _ = env_d.reset(seed=1)
+    assert "frame" not in od and "frame" not in env_d.observation_space.spaces
+    for _ in range(20):
+        np.testing.assert_array_equal(of["detections"], od["detections"])
+        of = env_f.step(NO_TRACKS)[0]
+        od = env_d.step(NO_TRACKS)[0]
+
+
+def test_async_vector_env_with_spawn():
+    envs = gym.make_vec("mtt_sim/Crossing-v0", num_envs=2, vectorization_mode="async",
+                        vector_kwargs={"context": "spawn"})
+    obs, _ = envs.reset(seed=[0, 1])
+    assert obs["frame"].shape == (2, 288, 384, 3)
+    for _ in range(50):
+        obs, reward, term, trunc, _ = envs.step(envs.action_space.sample())
+    assert reward.shape == (2,)
+    envs.close()
+
+
+def test_reset_info_gives_the_visible_initial_targets():
+    env = gym.make("mtt_sim/Books-v0")
+    _, info = env.reset(seed=0)
+    truth = env.unwrapped.truth
+    visible = truth.visibility > 0
+    np.testing.assert_array_equal(info["init_ids"], truth.ids[visible])
+    np.testing.assert_array_equal(info["init_boxes"], truth.boxes[visible])
+
+
+@pytest.mark.parametrize("action, pattern", [
+    ([1, 2], "action must be a dict with 'ids' and 'boxes'"),
+    ({"ids": [1]}, r"action must be a dict .* got dict with keys \['ids'\]"),
+    ({"ids": [1, 2], "boxes": [[0, 0, 5, 5]]}, r"unpadded action: 'ids' must have shape \(n,\) and 'boxes' \(n, 4\)"),
+    ({"ids": [1], "boxes": [[0, 0, np.nan, 5]]}, r"action\['boxes'\] row 0 is not finite"),
+    ({"ids": [1, 2], "boxes": [[0, 0, 5, 5], [0, 0, -1, 5]]}, r"row 1 has a non-positive width or height"),
+    ({"ids": [3, 3], "boxes": [[0, 0, 5, 5], [1, 1, 5, 5]]}, r"must be unique within a frame; repeated: \[3\]"),
+    ({"ids": [1.5], "boxes": [[0, 0, 5, 5]]}, r"action\['ids'\] must be integers"),
+    ({"ids": np.zeros(256, np.int64), "boxes": np.ones((256, 4)), "num_tracks": 999}, r"num_tracks'\] = 999: must be an integer in 0\.\.256"),
+    ({"ids": np.zeros(3, np.int64), "boxes": np.ones((3, 4)), "num_tracks": 1}, r"padded action: 'ids' must have shape \(256,\)"),
+])
+def test_bad_actions_say_what_is_wrong(action, pattern):
+    env = TrackingEnv("crossing")
+    env.reset(seed=0)
+    with pytest.raises(ActionError, match=pattern):
+        env.step(action)
+
+
+def test_padded_action_counts_only_num_tracks_rows():
+    env = TrackingEnv("crossing")
+    env.reset(seed=0)
+    ids = np.zeros(256, np.int64)
+    boxes = np.full((256, 4), np.nan, np.float32)  # rows past num_tracks are ignored
+    ids[0], boxes[0] = 5, (10, 10, 5, 5)
+    env.step({"ids": ids, "boxes": boxes, "num_tracks": 1})
+
+
+def test_bad_config_and_reset_options():
+    with pytest.raises(ConfigError, match=r"sensor\.clutter_rate = -1"):
+        gym.make("mtt_sim/Crossing-v0", config={"sensor.clutter_rate": -1})
+    env = TrackingEnv("clutter_storm", obs_mode="detections")
+    env.reset(seed=0, options={"config": {"sensor.clutter_rate": 0.0, "sensor.pd": 0.0}})
+    assert env.detections.rows.shape == (0, 5)
+    with pytest.raises(ValueError, match=r"cannot change render\.width"):
+        env.reset(options={"config": {"render.width": 100}})
+    with pytest.raises(ValueError, match="unknown key"):
+        env.reset(options={"seed": 3})
+    with pytest.raises(ValueError, match="render_mode='video'"):
+        TrackingEnv("crossing", render_mode="video")
+
+
+def test_terminated_when_everyone_left_and_truncated_at_max_steps():
+    g = {**still(), "speed": 4.0, "heading": 0.0, "heading_jitter": 0.0, "speed_jitter": 0.0}
+    env = TrackingEnv(tiny([g]))
+    env.reset(seed=0)
+    for step in range(1, 100):
+        _, _, term, trunc, _ = env.step(NO_TRACKS)
+        if term:
+            break
+    assert term is True and trunc is False and step < 40
+    with pytest.raises(RuntimeError, match="call reset"):
+        env.step(NO_TRACKS)
+    env = TrackingEnv("books", config={"env.max_steps": 3})
+    env.reset(seed=0)
+    flags = [env.step(NO_TRACKS)[3] for _ in range(3)]
+    assert flags == [False, False, True]
+
+
+def test_human_render_without_display_says_so(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(gym.error.DependencyNotInstalled, match="needs a display"):
+        gym.make("mtt_sim/Crossing-v0", render_mode="human")
+
+
+def test_truth_is_exposed_on_the_unwrapped_env():
+    env = gym.make("mtt_sim/Soccer-v0")
+    env.reset(seed=0)
+    t = env.unwrapped.truth
+    assert len(t) == 22 and t.boxes.dtype == np.float32 and len(set(t.ids.tolist())) == 22

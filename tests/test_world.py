@@ -1,0 +1,121 @@
+"""The pymunk world: motion models, collisions, layers, carrying, births and deaths."""
+
+import numpy as np
+
+from helpers import still, tiny
+from mtt_sim.scenario import load
+from mtt_sim.world import World
+
+
+def world(sc, seed=0):
+    return World(sc, np.random.default_rng(seed))
+
+
+def moving(name, x, vx, layer=0):
+    g = still(name=name, layer=layer, size=(20.0, 20.0))
+    g.update(region=[x, 0.45, x + 0.01, 0.55], speed=abs(vx), heading=0.0 if vx > 0 else 180.0, heading_jitter=0.0,
+             speed_jitter=0.0, accel=0.0)
+    return g
+
+
+def test_same_layer_targets_bounce_and_other_layers_pass_through():
+    for layers, swapped in (((0, 0), False), ((0, 1), True)):
+        w = world(tiny([moving("a", 0.3, 2.0, layers[0]), moving("b", 0.7, -2.0, layers[1])]))
+        for _ in range(25):  # they meet after about 15 frames
+            w.step()
+        assert (w.pos[0, 0] > w.pos[1, 0]) == swapped, layers
+
+
+def test_walls_keep_targets_inside_the_world():
+    w = world(load("dense", {"groups.0.speed": 6.0, "groups.0.count": 50}))
+    for _ in range(200):
+        w.step()
+    assert len(w.ids) == 50
+    assert (w.pos >= 0).all() and (w.pos <= w.extent).all()
+
+
+def test_without_walls_targets_leave_and_die():
+    w = world(tiny([moving("a", 0.5, 5.0)]))
+    for _ in range(40):
+        w.step()
+    assert len(w.ids) == 0 and w.finished
+
+
+def test_carried_target_keeps_its_offset_to_the_carrier():
+    w = world(load("books"))
+    carried = int(np.flatnonzero(w.group == 1)[0])
+    carrier = int(np.flatnonzero(w.group == 0)[0])
+    offset = w.pos[carried] - w.pos[carrier]
+    start = w.pos[carrier].copy()
+    for _ in range(100):
+        w.step()
+    assert np.linalg.norm(w.pos[carrier] - start) > 5  # the carrier did move
+    np.testing.assert_allclose(w.pos[carried] - w.pos[carrier], offset, atol=0.5)
+
+
+def test_border_births_enter_inward_with_unique_ids():
+    sc = tiny([{**still(count=0), "birth_rate": 0.5, "speed": 2.0, "heading_jitter": 180.0}])
+    w = world(sc)
+    seen = set()
+    for _ in range(100):
+        w.step()
+        born_now = w.born == w.t
+        to_centre = w.extent / 2 - w.pos[born_now]
+        assert (np.sum(to_centre * w.vel[born_now], axis=1) > 0).all()
+        assert len(set(w.ids.tolist())) == len(w.ids)
+        seen |= set(w.ids.tolist())
+    assert w.births > 20 and seen == set(range(1, w.next_id)) & seen
+
+
+def test_exit_door_absorbs_goal_seekers():
+    door = {"rect": [180.0, 40.0, 20.0, 20.0], "role": "exit"}
+    g = {**still(), "motion": "goal", "speed": 3.0, "region": [0.05, 0.45, 0.1, 0.55]}
+    w = world(tiny([g], doors=[door]))
+    for _ in range(100):
+        w.step()
+        if not len(w.ids):
+            break
+    assert len(w.ids) == 0 and w.t < 100
+
+
+def test_door_births_and_population_cap():
+    door = {"rect": [90.0, 40.0, 20.0, 20.0], "role": "entry", "birth_rate": 5.0}
+    w = world(tiny([still(count=0)], doors=[door], world={"max_alive": 7, "max_births": 10}))
+    for _ in range(30):
+        w.step()
+        assert len(w.ids) <= 7
+    assert w.births <= 10
+
+
+def test_standing_targets_shrink_as_they_walk_away():
+    g = {**still(size=(20.0, 50.0)), "region": [0.5, 0.9, 0.51, 0.95], "speed": 1.0, "heading": -90.0,
+         "heading_jitter": 0.0, "speed_jitter": 0.0}
+    w = world(tiny([g], world={"projection": "standing", "far_scale": 0.4}, render={"height": 300}))
+    h0 = w.boxes()[0, 3]
+    for _ in range(100):
+        w.step()
+    assert w.boxes()[0, 3] < 0.85 * h0
+
+
+def test_random_walk_velocity_is_redrawn_each_frame():
+    g = {**still(count=30), "motion": "random_walk", "speed": 2.0, "region": [0.1, 0.1, 0.9, 0.9], "size": [2.0, 2.0]}
+    w = world(tiny([g], world={"walls": True, "collision": "none"}, render={"width": 600, "height": 600}))
+    vels = []
+    for _ in range(50):
+        w.step()
+        vels.append(w.vel.copy())
+    v = np.concatenate(vels)
+    assert abs(v.std() - 2.0) < 0.2
+    lag = np.mean(np.sum(vels[0] * vels[1], axis=1))
+    assert abs(lag) < 1.5  # successive velocities are independent
+
+
+def test_manoeuvring_targets_turn_and_stop():
+    g = {**still(count=20), "motion": "manoeuvre", "speed": 2.0, "turn_prob": 0.2, "stop_prob": 0.05,
+         "region": [0.1, 0.1, 0.9, 0.9], "size": [2.0, 2.0]}
+    w = world(tiny([g], world={"walls": True, "collision": "none"}, render={"width": 600, "height": 600}))
+    stopped = 0
+    for _ in range(60):
+        w.step()
+        stopped += int(w.stopped.sum())
+    assert stopped > 0 and (np.hypot(*w.vel.T) > 0).any()
