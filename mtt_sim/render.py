@@ -94,7 +94,6 @@ class Renderer:
         self.occluder_boxes = np.array([o.rect for o in occ], float).reshape(-1, 4)
         self.occluder_depth = (self.occluder_boxes[:, 1] + self.occluder_boxes[:, 3]) if sc.world.projection == "standing" \
             else np.full(len(occ), np.inf)
-        self.gain = 1.0
 
     def _background(self) -> np.ndarray:
         """The static world backdrop, with a margin for a shaking camera."""
@@ -190,7 +189,6 @@ class Renderer:
         gain = r.brightness * (1 + r.illumination_drift * math.sin(2 * math.pi * t / r.illumination_period))
         if r.flicker > 0:
             gain *= 1 + r.flicker * rng.normal()
-        self.gain = gain
         if gain != 1.0:
             frame = cv2.convertScaleAbs(frame, alpha=gain)
         if self.noise_bank:

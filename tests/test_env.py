@@ -73,12 +73,14 @@ def test_detections_mode_sees_the_same_world_without_frames():
         od = env_d.step(NO_TRACKS)[0]
 
 
-def test_async_vector_env_with_spawn():
+@pytest.mark.parametrize("context, steps", [("spawn", 50), ("fork", 5), ("forkserver", 5)])
+def test_async_vector_env(context, steps):
     envs = gym.make_vec("mtt_sim/Crossing-v0", num_envs=2, vectorization_mode="async",
-                        vector_kwargs={"context": "spawn"})
+                        vector_kwargs={"context": context})
     obs, _ = envs.reset(seed=[0, 1])
     assert obs["frame"].shape == (2, 288, 384, 3)
-    for _ in range(50):
+    assert not np.array_equal(obs["frame"][0], obs["frame"][1])
+    for _ in range(steps):
         obs, reward, term, trunc, _ = envs.step(envs.action_space.sample())
     assert reward.shape == (2,)
     envs.close()
