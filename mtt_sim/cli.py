@@ -12,10 +12,9 @@ import numpy as np
 from . import perf, scenario
 from .env import TrackingEnv
 from .overlay import VideoWriter
-from .truth import Truth
 
 ECHO_NOTE = ("The agent is a trivial built-in one that echoes each frame's detections as tracks, numbered afresh "
-             "every frame (no tracker yet), so the figures describe the detector, not a tracker.")
+             "every frame (no tracker yet): a floor for trackers, with many identity switches.")
 
 
 def parse_overrides(items: list[str]) -> dict:
@@ -32,25 +31,8 @@ def parse_overrides(items: list[str]) -> dict:
     return out
 
 
-def _iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    lo = np.maximum(a[:, None, :2], b[None, :, :2])
-    hi = np.minimum(a[:, None, :2] + a[:, None, 2:], b[None, :, :2] + b[None, :, 2:])
-    inter = np.prod(np.clip(hi - lo, 0, None), axis=2)
-    union = np.prod(a[:, 2:], axis=1)[:, None] + np.prod(b[:, 2:], axis=1)[None] - inter
-    return inter / np.maximum(union, 1e-12)
-
-
-def _detector_counts(truth: Truth, rows: np.ndarray) -> tuple[int, int]:
-    """(true positives, detections) with a greedy IoU >= 0.5 match, for the echo agent's summary."""
-    if not len(truth) or not len(rows):
-        return 0, len(rows)
-    iou = _iou(truth.boxes, rows[:, :4])
-    hits = 0
-    while iou.size and iou.max() >= 0.5:
-        i, j = np.unravel_index(np.argmax(iou), iou.shape)
-        iou[i, :], iou[:, j] = 0, 0
-        hits += 1
-    return hits, len(rows)
+SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "TP", "FP", "FN", "IDSW", "Frag",
+                "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
 
 
 def cmd_run(args) -> int:
@@ -58,31 +40,29 @@ def cmd_run(args) -> int:
     obs, _ = env.reset(seed=args.seed)
     steps = args.steps or env.scenario.env.max_steps
     writer = VideoWriter(args.video, (env.scenario.render.width, env.scenario.render.height)) if args.video else None
-    gt = tp = dets = frames = 0
+    total = 0.0
     for _ in range(steps):
         n = int(obs["num_detections"])
-        hits, count = _detector_counts(env.truth, obs["detections"][:n])
-        gt, tp, dets, frames = gt + len(env.truth), tp + hits, dets + count, frames + 1
         action = {"ids": np.arange(n), "boxes": obs["detections"][:n, :4]}
         if writer:
             env._remember(*env.validate_action(action))
             writer.write(env.render())
-        obs, _, terminated, truncated, _ = env.step(action)
+        obs, reward, terminated, truncated, _ = env.step(action)
+        total += reward
         if terminated or truncated:
             break
     if writer:
         writer.close()
-    summary = {"scenario": args.scenario, "seed": args.seed, "frames": frames, "gt_boxes": gt, "detections": dets,
-               "detector_recall": tp / max(gt, 1), "detector_precision": tp / max(dets, 1),
-               "births": env.world.births, "agent": "echo (detections as tracks)"}
+    summary = {"scenario": args.scenario, "seed": args.seed, "agent": "echo", "return": total,
+               **{k: v for k, v in env.metrics.summary().items() if k in SUMMARY_KEYS}}
     if args.json:
         print(json.dumps(summary))
     else:
         print(ECHO_NOTE)
         for k, v in summary.items():
-            print(f"{k:20s} {v:.3f}" if isinstance(v, float) else f"{k:20s} {v}")
+            print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
         if args.video:
-            print(f"{'video':20s} {args.video}")
+            print(f"{'video':12s} {args.video}")
     return 0
 
 
@@ -96,6 +76,8 @@ def cmd_list(args) -> int:
 
 def cmd_perf(args) -> int:
     print(perf.report(perf.measure(repeats=args.repeats, steps=args.steps)))
+    print()
+    print(perf.report_metrics(perf.measure_metrics(repeats=args.repeats)))
     return 0
 
 
@@ -119,7 +101,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides, e.g. sensor.clutter_rate=5")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.set_defaults(func=cmd_run)
-    pf = sub.add_parser("perf", help="env steps per second at 20 and 200 targets, against an OpenCV drawing reference")
+    pf = sub.add_parser("perf", help="env steps/s and metrics cost at 20 and 200 targets, each against a same-run reference")
     pf.add_argument("--repeats", type=int, default=5)
     pf.add_argument("--steps", type=int, default=200)
     pf.set_defaults(func=cmd_perf)

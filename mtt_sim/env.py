@@ -18,6 +18,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import scenario as scn
+from .metrics import EpisodeMetrics, FrameStats
 from .overlay import draw_overlay
 from .render import Renderer
 from .sensor import Detections, make_sensor
@@ -44,13 +45,18 @@ class TrackingEnv(gym.Env):
     num_tracks=Discrete(max_tracks + 1))``: the tracker's tracks for the frame it was shown (the first
     ``num_tracks`` rows count). A dict of unpadded ``ids`` (n,) and ``boxes`` (n, 4) is accepted too.
 
-    **Reward** a placeholder 0.0 until the metrics land (``info["reward_note"]`` says so).
+    **Reward** by ``scoring.reward_mode``, scoring the action against the ground truth of the frame the
+    agent was shown: ``"mota"`` (default) TP - FP - IDSW, so the undiscounted return divided by the
+    number of ground-truth boxes is MOTA; ``"gospa"`` minus the frame's GOSPA; ``"iou"`` the weighted
+    summed similarity of the matches minus weighted FP and FN counts.
 
     **Episode end** ``terminated`` when no target is alive and none can be born any more;
     ``truncated`` after ``env.max_steps`` steps.
 
     **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
-    trackers initialised by hand. ``env.unwrapped.truth`` is the current ground truth.
+    trackers initialised by hand. Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
+    num_gt, similarity_sum); on the last step ``info["metrics"]``, the episode's MOTA, IDF1, HOTA, GOSPA
+    and the rest (see ``mtt_sim.metrics``). ``env.unwrapped.truth`` is the current ground truth.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 25}
@@ -105,6 +111,8 @@ class TrackingEnv(gym.Env):
         self.renderer = Renderer(sc, render_rng)
         empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
         self.sensor = make_sensor(sc, sensor_rng, empty)
+        s = sc.scoring
+        self.metrics = EpisodeMetrics(s.similarity, s.threshold, s.zero_distance, s.gospa_c, s.gospa_p)
         self.steps = 0
         self._done = False
         self._trails: dict[int, deque] = {}
@@ -128,7 +136,9 @@ class TrackingEnv(gym.Env):
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self._remember(ids, boxes)
-        reward = 0.0
+        scored = self.truth.visibility >= self.scenario.scoring.min_visibility
+        stats = self.metrics.update(self.truth.ids[scored], self.truth.boxes[scored], ids, boxes)
+        reward = self._reward(stats)
         self.world.step()
         self.renderer.camera.advance()
         self.steps += 1
@@ -136,8 +146,18 @@ class TrackingEnv(gym.Env):
         terminated = bool(self.world.finished)
         truncated = bool(self.steps >= self.scenario.env.max_steps and not terminated)
         self._done = terminated or truncated
-        info = {"frame_index": self.steps, "reward_note": "placeholder 0.0: the metrics are not implemented yet"}
+        info = {"frame_index": self.steps, "frame": dict(vars(stats))}
+        if self._done:
+            info["metrics"] = self.metrics.summary()
         return obs, float(reward), terminated, truncated, info
+
+    def _reward(self, stats: FrameStats) -> float:
+        s = self.scenario.scoring
+        if s.reward_mode == "mota":
+            return float(stats.tp - stats.fp - stats.idsw)
+        if s.reward_mode == "gospa":
+            return -self.metrics.frame_gospa()
+        return s.iou_weight * stats.similarity_sum - s.fp_weight * stats.fp - s.fn_weight * stats.fn
 
     def observe(self) -> dict[str, Any]:
         """Render, measure the truth and detect for the world as it is now (after reset/step, or after `world.place`)."""

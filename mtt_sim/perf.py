@@ -1,7 +1,8 @@
-"""`mtt-sim perf`: env step throughput, with a reference measured in the same run.
+"""`mtt-sim perf`: env step and metrics throughput, each with a reference measured in the same run.
 
-The reference is the least any frame-producing step must do: copy a background of the same size
-and draw the same N filled ellipses with OpenCV. Figures are medians over repeats.
+Env reference: the least any frame-producing step must do, copying a background of the same size
+and drawing the same N filled ellipses with OpenCV. Metrics reference: the least a CLEAR update
+must do, one IoU matrix and one Hungarian assignment per frame. Figures are medians over repeats.
 """
 
 from __future__ import annotations
@@ -11,8 +12,10 @@ import time
 
 import cv2
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from .env import TrackingEnv
+from .metrics import EpisodeMetrics, box_iou
 
 SIZE = (640, 480)
 
@@ -68,4 +71,54 @@ def report(rows: list[dict]) -> str:
            "|---:|---:|---:|---:|---:|"]
     out += [f"| {r['targets']} | {r['frames_steps_per_s']:.0f} | {r['detections_steps_per_s']:.0f} | "
             f"{r['reference_per_s']:.0f} | {r['step_over_reference']:.2f}x |" for r in rows]
+    return "\n".join(out)
+
+
+def _sequence(n: int, frames: int, seed: int = 0):
+    """A synthetic sequence: n targets drifting, tracks with noise, a few swapped ids and misses."""
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(0, 600, (n, 2))
+    out = []
+    for _ in range(frames):
+        pos += rng.normal(0, 2, pos.shape)
+        gt = np.c_[pos, np.full((n, 2), 24.0)]
+        keep = rng.random(n) < 0.9
+        trk = gt[keep] + rng.normal(0, 2, (keep.sum(), 4)) * [1, 1, 0.2, 0.2]
+        ids = np.flatnonzero(keep)
+        ids = np.where(rng.random(len(ids)) < 0.02, ids + 1000, ids)
+        out.append((np.arange(n), gt, ids, trk))
+    return out
+
+
+def _time(fn) -> float:
+    start = time.perf_counter()
+    fn()
+    return time.perf_counter() - start
+
+
+def measure_metrics(repeats: int = 5) -> list[dict]:
+    """Medians of EpisodeMetrics.update per frame (20 and 200 objects) and of the summary of 1000 x 20."""
+    rows = []
+    for n, frames in ((20, 1000), (200, 100)):
+        seq = _sequence(n, frames)
+        runs = []
+        for _ in range(repeats):
+            m = EpisodeMetrics()
+            upd = _time(lambda: [m.update(*f) for f in seq]) / frames
+            ref = _time(lambda: [linear_sum_assignment(box_iou(f[1], f[3]), maximize=True) for f in seq]) / frames
+            summ = _time(m.summary)
+            runs.append((upd, ref, summ))
+        upd, ref, summ = (statistics.median(r[i] for r in runs) for i in range(3))
+        rows.append({"objects": n, "frames": frames, "update_us": upd * 1e6, "reference_us": ref * 1e6,
+                     "update_over_reference": upd / ref, "summary_s": summ})
+    return rows
+
+
+def report_metrics(rows: list[dict]) -> str:
+    """Markdown table of `measure_metrics`' rows."""
+    out = ["EpisodeMetrics cost, medians (reference: IoU matrix + one Hungarian assignment per frame)",
+           "| objects | frames | update per frame | reference per frame | update / reference | summary of all frames |",
+           "|---:|---:|---:|---:|---:|---:|"]
+    out += [f"| {r['objects']} | {r['frames']} | {r['update_us']:.0f} us | {r['reference_us']:.0f} us | "
+            f"{r['update_over_reference']:.2f}x | {r['summary_s'] * 1e3:.1f} ms |" for r in rows]
     return "\n".join(out)

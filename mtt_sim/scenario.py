@@ -174,6 +174,25 @@ class EnvConfig:
 
 
 @dataclass(frozen=True)
+class ScoringConfig:
+    """How tracks are scored against ground truth: the matching, the GOSPA parameters and the per-step reward."""
+
+    similarity: str = spec("iou", "iou: box overlap; centroid: max(0, 1 - centre distance / zero_distance)",
+                           choices=("iou", "centroid"))
+    threshold: float = spec(0.5, "a track matches a target when their similarity is at least this (CLEAR, IDF1)", "", 0.01, 1.0)
+    zero_distance: float = spec(20.0, "centroid similarity reaches 0 at this centre distance", "px", 0.1, 1e5)
+    gospa_c: float = spec(50.0, "GOSPA cut-off distance (a miss or a false track costs c/2)", "px", 0.1, 1e5)
+    gospa_p: float = spec(1.0, "GOSPA order", "", 1.0, 10.0)
+    min_visibility: float = spec(0.0, "targets less visible than this are not scored (0 = every target in the image)", "", 0.0, 1.0)
+    reward_mode: str = spec("mota", "mota: TP - FP - IDSW (return / GT boxes = MOTA); gospa: -GOSPA of the frame; "
+                            "iou: iou_weight * summed IoU of matches - fp_weight * FP - fn_weight * FN",
+                            choices=("mota", "gospa", "iou"))
+    iou_weight: float = spec(1.0, "reward_mode iou: weight of the matched similarity", "", 0.0, 1e3)
+    fp_weight: float = spec(1.0, "reward_mode iou: cost of a false track", "", 0.0, 1e3)
+    fn_weight: float = spec(1.0, "reward_mode iou: cost of a missed target", "", 0.0, 1e3)
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A named scenario: everything needed to build and run one episode."""
 
@@ -183,6 +202,7 @@ class Scenario:
     render: RenderConfig = table(RenderConfig, "the frame")
     sensor: SensorConfig = table(SensorConfig, "the detector")
     env: EnvConfig = table(EnvConfig, "the Gym face")
+    scoring: ScoringConfig = table(ScoringConfig, "scoring and rewards")
     groups: tuple[GroupConfig, ...] = spec((GroupConfig(),), "target groups ([[groups]] tables)")
     doors: tuple[DoorConfig, ...] = spec((), "entry/exit doors ([[doors]] tables)")
     occluders: tuple[OccluderConfig, ...] = spec((), "static occluders ([[occluders]] tables)")
@@ -456,6 +476,6 @@ def reference_table() -> str:
 
 
 __all__ = ["Scenario", "GroupConfig", "DoorConfig", "OccluderConfig", "WorldConfig", "RenderConfig", "SensorConfig",
-           "EnvConfig", "ConfigError", "PRESETS", "available", "load", "load_raw", "from_mapping", "to_mapping",
+           "EnvConfig", "ScoringConfig", "ConfigError", "PRESETS", "available", "load", "load_raw", "from_mapping", "to_mapping",
            "merge", "expand_dotted", "reference_table"]
 

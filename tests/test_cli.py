@@ -25,7 +25,7 @@ def test_run_prints_a_summary_and_writes_a_video(tmp_path, capsys):
     assert cli.main(["run", "crossing", "--seed", "0", "--steps", "30", "--video", str(video),
                      "--config", "sensor.clutter_rate=2"]) == 0
     text = capsys.readouterr().out
-    assert "echoes each frame's detections" in text and "detector_recall" in text
+    assert "echoes each frame's detections" in text and "MOTA" in text and "HOTA" in text
     cap = cv2.VideoCapture(str(video))
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 30 and int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)) == 384
 
@@ -35,7 +35,7 @@ def test_run_json_is_deterministic(capsys):
     first = capsys.readouterr().out
     cli.main(["run", "clutter_storm", "--steps", "20", "--json"])
     assert json.loads(first) == json.loads(capsys.readouterr().out)
-    assert json.loads(first)["frames"] == 20
+    assert json.loads(first)["num_frames"] == 20
 
 
 def test_errors_are_one_line_with_exit_code_two():
@@ -58,3 +58,6 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert [r["targets"] for r in rows] == [20, 200]
     assert all(r["frames_steps_per_s"] > 0 and r["step_over_reference"] > 0 for r in rows)
     assert "step / reference" in perf.report(rows)
+    rows = perf.measure_metrics(repeats=1)
+    assert [r["objects"] for r in rows] == [20, 200] and all(r["update_us"] > 0 and r["summary_s"] > 0 for r in rows)
+    assert "update / reference" in perf.report_metrics(rows)

@@ -165,3 +165,38 @@ def test_truth_is_exposed_on_the_unwrapped_env():
     env.reset(seed=0)
     t = env.unwrapped.truth
     assert len(t) == 22 and t.boxes.dtype == np.float32 and len(set(t.ids.tolist())) == 22
+
+
+def episode(env_id, seed=0, **kwargs):
+    env = gym.make(env_id, **kwargs)
+    obs, _ = env.reset(seed=seed)
+    rewards, frames = [], []
+    while True:
+        obs, reward, term, trunc, info = env.step(echo(obs))
+        rewards.append(reward)
+        frames.append(info["frame"])
+        if term or trunc:
+            return rewards, frames, info
+
+
+def test_mota_return_over_gt_boxes_is_mota():
+    rewards, frames, info = episode("mtt_sim/Crossing-v0", config={"env.max_steps": 120})
+    m = info["metrics"]
+    assert sum(rewards) / m["num_gt_dets"] == pytest.approx(m["MOTA"], abs=1e-12)
+    assert m["num_frames"] == len(rewards) == 120
+    assert sum(f["tp"] for f in frames) == m["TP"] and sum(f["idsw"] for f in frames) == m["IDSW"]
+    assert {"MOTA", "IDF1", "HOTA", "GOSPA", "MT"} <= set(m)
+
+
+def test_gospa_and_iou_rewards():
+    rewards, _, info = episode("mtt_sim/ClutterStorm-v0", config={"env.max_steps": 30, "scoring.reward_mode": "gospa"})
+    assert -np.mean(rewards) == pytest.approx(info["metrics"]["GOSPA"])
+    cfg = {"env.max_steps": 30, "scoring.reward_mode": "iou", "scoring.fp_weight": 0.5, "scoring.fn_weight": 2.0}
+    rewards, frames, _ = episode("mtt_sim/ClutterStorm-v0", config=cfg)
+    for r, f in zip(rewards, frames):
+        assert r == pytest.approx(f["similarity_sum"] - 0.5 * f["fp"] - 2.0 * f["fn"])
+
+
+def test_min_visibility_drops_hidden_targets_from_scoring():
+    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5, "scoring.min_visibility": 0.5})
+    assert all(f["num_gt"] < 4 for f in frames)  # the book under the top book is not scored
