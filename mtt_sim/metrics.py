@@ -151,6 +151,8 @@ class EpisodeMetrics:
     # ------------------------------------------------------------ per frame
 
     def _similarity(self, gt_boxes: np.ndarray, trk_boxes: np.ndarray) -> np.ndarray:
+        if not len(gt_boxes) or not len(trk_boxes):
+            return np.zeros((len(gt_boxes), len(trk_boxes)))
         if self.similarity == "iou":
             return box_iou(gt_boxes, trk_boxes)
         return np.maximum(0.0, 1.0 - centre_distance(gt_boxes, trk_boxes) / self.zero_distance)
@@ -162,8 +164,9 @@ class EpisodeMetrics:
         g, t = self._gt_ids(gt_ids), self._trk_ids(trk_ids)
         sim = self._similarity(gt_boxes, trk_boxes)
         self._frames.append((g, t, sim, gt_boxes, trk_boxes))
-        for arr in (self._last, self._prev, self._seen, self._matched, self._frag):
-            arr.ensure(len(self._gt_ids))
+        if len(self._gt_ids) > len(self._seen.a):
+            for arr in (self._last, self._prev, self._seen, self._matched, self._frag):
+                arr.ensure(len(self._gt_ids))
         if not len(g):  # TrackEval skips the frame before resetting the previous-timestep matches
             self.fp += len(t)
             return FrameStats(0, len(t), 0, 0, 0, 0.0)
