@@ -88,7 +88,7 @@ class TrackingEnv(gym.Env):
         obs = {"detections": spaces.Box(0.0, det_high, (nd, 5), np.float32), "num_detections": spaces.Discrete(nd + 1)}
         if sc.env.obs_mode == "frame+detections":
             obs = {"frame": spaces.Box(0, 255, (h, w, 3), np.uint8), **obs}
-        box_low = np.tile(np.array([-w, -h, 1, 1], np.float32), (nt, 1))
+        box_low = np.tile(np.array([-w, -h, 0, 0], np.float32), (nt, 1))  # zero rows pad; used rows need w, h > 0
         box_high = np.tile(np.array([2 * w, 2 * h, 2 * w, 2 * h], np.float32), (nt, 1))
         act = {"ids": spaces.Box(0, 2**31 - 1, (nt,), np.int64), "boxes": spaces.Box(box_low, box_high, (nt, 4), np.float32),
                "num_tracks": spaces.Discrete(nt + 1)}

@@ -1,0 +1,12 @@
+"""Tracker agents for mtt-sim: pure numpy/scipy/OpenCV, never importing mtt_sim or seeing ground truth.
+
+    import trackers
+    trackers.available()                 # names with one-line descriptions
+    t = trackers.make("sort", max_age=3) # or trackers.make("sort:max_age=3")
+    t.reset(info); tracks = t.update(obs); env.step(tracks.to_action(env.action_space))
+"""
+
+from . import bytetrack, gnn, iou, sort  # noqa: F401  (each registers its tracker)
+from .base import Tracker, Tracks, available, make, parse_spec, register
+
+__all__ = ["Tracker", "Tracks", "available", "make", "parse_spec", "register"]

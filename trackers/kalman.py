@@ -1,0 +1,111 @@
+"""Linear Kalman filters with constant-velocity models, many at once.
+
+A `KalmanBank` holds N independent filters that share their model matrices as stacked arrays
+(x: (N, d), P: (N, d, d)), so predicting or updating every track is a few batched matrix
+products instead of a Python loop over track objects.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Model:
+    """F (transition), H (measurement), Q (process noise), R (measurement noise), P0 (initial covariance)."""
+
+    F: np.ndarray
+    H: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    P0: np.ndarray
+
+
+def box_model() -> Model:
+    """SORT's model (Bewley et al. 2016): state (cx, cy, s, r, vcx, vcy, vs), measurement (cx, cy, s, r),
+    s = area, r = aspect ratio w / h held constant; the noise values of the SORT reference code."""
+    F = np.eye(7)
+    F[0, 4] = F[1, 5] = F[2, 6] = 1.0
+    H = np.eye(4, 7)
+    Q = np.diag([1.0, 1.0, 1.0, 1.0, 0.01, 0.01, 1e-4])
+    R = np.diag([1.0, 1.0, 10.0, 10.0])
+    P0 = np.diag([10.0, 10.0, 10.0, 10.0, 1e4, 1e4, 1e4])
+    return Model(F, H, Q, R, P0)
+
+
+def point_model(accel_sigma: float = 1.0, meas_sigma: float = 2.0, vel_sigma0: float = 10.0) -> Model:
+    """Constant velocity in the plane: state (px, py, vx, vy), measurement (px, py); white-noise acceleration."""
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = 1.0
+    G = np.array([[0.5, 0.0], [0.0, 0.5], [1.0, 0.0], [0.0, 1.0]])
+    return Model(F, np.eye(2, 4), accel_sigma**2 * G @ G.T, meas_sigma**2 * np.eye(2),
+                 np.diag([meas_sigma**2, meas_sigma**2, vel_sigma0**2, vel_sigma0**2]))
+
+
+def boxes_to_z(boxes: np.ndarray) -> np.ndarray:
+    """x, y, w, h -> SORT's measurement cx, cy, s, r."""
+    boxes = np.asarray(boxes, float).reshape(-1, 4)
+    w, h = boxes[:, 2], boxes[:, 3]
+    return np.stack([boxes[:, 0] + w / 2, boxes[:, 1] + h / 2, w * h, w / np.maximum(h, 1e-9)], axis=1)
+
+
+def z_to_boxes(z: np.ndarray) -> np.ndarray:
+    """SORT's cx, cy, s, r (first four state entries) -> x, y, w, h."""
+    s, r = np.maximum(z[:, 2], 0.0), np.maximum(z[:, 3], 1e-9)
+    w = np.sqrt(s * r)
+    h = s / np.maximum(w, 1e-9)
+    return np.stack([z[:, 0] - w / 2, z[:, 1] - h / 2, w, h], axis=1)
+
+
+class KalmanBank:
+    """N Kalman filters sharing one Model."""
+
+    def __init__(self, model: Model):
+        self.m = model
+        d = model.F.shape[0]
+        self.x, self.P = np.zeros((0, d)), np.zeros((0, d, d))
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def add(self, z: np.ndarray) -> None:
+        """Start filters at measurements z (n, k): measured entries set, the rest zero, covariance P0."""
+        z = np.asarray(z, float).reshape(-1, self.m.H.shape[0])
+        x = z @ self.m.H  # H is a selection matrix: this places each measurement in its state entries
+        self.x = np.concatenate([self.x, x])
+        self.P = np.concatenate([self.P, np.broadcast_to(self.m.P0, (len(z),) + self.m.P0.shape)])
+
+    def keep(self, mask: np.ndarray) -> None:
+        self.x, self.P = self.x[mask], self.P[mask]
+
+    def predict(self) -> None:
+        F = self.m.F
+        self.x = self.x @ F.T
+        self.P = F @ self.P @ F.T + self.m.Q
+
+    def innovation_covariance(self, rows=slice(None)) -> np.ndarray:
+        H = self.m.H
+        return H @ self.P[rows] @ H.T + self.m.R
+
+    def measurement(self) -> np.ndarray:
+        """Predicted measurements (N, k)."""
+        return self.x @ self.m.H.T
+
+    def mahalanobis(self, z: np.ndarray) -> np.ndarray:
+        """(N, M) squared Mahalanobis distances of measurements z (M, k) from each filter's prediction."""
+        diff = np.asarray(z, float)[None, :, :] - self.measurement()[:, None, :]
+        S_inv = np.linalg.inv(self.innovation_covariance())
+        return np.einsum("nmi,nij,nmj->nm", diff, S_inv, diff)
+
+    def update(self, rows: np.ndarray, z: np.ndarray) -> None:
+        """Correct filters `rows` with measurements z (len(rows), k)."""
+        if not len(rows):
+            return
+        H, P = self.m.H, self.P[rows]
+        S = H @ P @ H.T + self.m.R
+        K = np.linalg.solve(S, H @ P).transpose(0, 2, 1)  # P H^T S^-1, using the symmetry of P and S
+        innovation = np.asarray(z, float) - self.x[rows] @ H.T
+        self.x[rows] += np.einsum("nij,nj->ni", K, innovation)
+        self.P[rows] = P - K @ H @ P
