@@ -7,14 +7,10 @@ import json
 import sys
 import tomllib
 
-import numpy as np
+from . import experiment, perf, scenario
 
-from . import perf, scenario
-from .env import TrackingEnv
-from .overlay import VideoWriter
-
-ECHO_NOTE = ("The agent is a trivial built-in one that echoes each frame's detections as tracks, numbered afresh "
-             "every frame (no tracker yet): a floor for trackers, with many identity switches.")
+SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "TP", "FP", "FN", "IDSW", "Frag",
+                "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
 
 
 def parse_overrides(items: list[str]) -> dict:
@@ -24,45 +20,63 @@ def parse_overrides(items: list[str]) -> dict:
         key, sep, value = item.partition("=")
         if not sep or not key:
             raise scenario.ConfigError(f"--config {item!r}: expected key=value, e.g. sensor.clutter_rate=5")
-        try:
-            out[key] = tomllib.loads(f"v = {value}")["v"]
-        except tomllib.TOMLDecodeError:
-            out[key] = value
+        out[key] = _toml_value(value)
     return out
 
 
-SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "TP", "FP", "FN", "IDSW", "Frag",
-                "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
+def _toml_value(text: str):
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
 
 
 def cmd_run(args) -> int:
-    env = TrackingEnv(args.scenario, config=parse_overrides(args.config), render_mode="rgb_array" if args.video else None)
-    obs, _ = env.reset(seed=args.seed)
-    steps = args.steps or env.scenario.env.max_steps
-    writer = VideoWriter(args.video, (env.scenario.render.width, env.scenario.render.height)) if args.video else None
-    total = 0.0
-    for _ in range(steps):
-        n = int(obs["num_detections"])
-        action = {"ids": np.arange(n), "boxes": obs["detections"][:n, :4]}
-        if writer:
-            env._remember(*env.validate_action(action))
-            writer.write(env.render())
-        obs, reward, terminated, truncated, _ = env.step(action)
-        total += reward
-        if terminated or truncated:
-            break
-    if writer:
-        writer.close()
-    summary = {"scenario": args.scenario, "seed": args.seed, "agent": "echo", "return": total,
-               **{k: v for k, v in env.metrics.summary().items() if k in SUMMARY_KEYS}}
+    record = experiment.run_episode(args.scenario, args.tracker, args.seed, parse_overrides(args.config),
+                                    video=args.video, steps=args.steps or None)
+    summary = {"scenario": args.scenario, "tracker": args.tracker, "seed": args.seed,
+               **{k: record["metrics"][k] for k in SUMMARY_KEYS},
+               "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
     if args.json:
         print(json.dumps(summary))
-    else:
-        print(ECHO_NOTE)
-        for k, v in summary.items():
-            print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
-        if args.video:
-            print(f"{'video':12s} {args.video}")
+        return 0
+    for k, v in summary.items():
+        print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
+    if args.video:
+        print(f"{'video':12s} {args.video}")
+    return 0
+
+
+def _grid_output(args, records, rows, title=""):
+    if args.out:
+        experiment.write_records(records, args.out)
+    print(experiment.markdown(rows, title))
+    if args.out:
+        print(f"\nrecords: {args.out}")
+
+
+def cmd_bench(args) -> int:
+    records = experiment.run_grid(args.trackers.split(","), args.scenarios.split(","), args.seeds,
+                                  config=parse_overrides(args.config), workers=args.workers, progress=True)
+    _grid_output(args, records, experiment.summarize(records, args.metric))
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    key, sep, values = args.param.partition("=")
+    if not sep or not values:
+        raise scenario.ConfigError(f"--param {args.param!r}: expected key=v1,v2,..., e.g. sensor.clutter_rate=0,5,10")
+    values = [_toml_value(v) for v in values.split(",")]
+    records = experiment.run_grid(args.trackers.split(","), [args.scenario], args.seeds,
+                                  config=parse_overrides(args.config), configs=[{key: v} for v in values],
+                                  workers=args.workers, progress=True)
+    rows = experiment.summarize(records, args.metric, by="config")
+    for r in rows:
+        r["column"] = f"{key.split('.')[-1]}={json.loads(r['column'])[key]}"
+    _grid_output(args, records, rows, f"{args.scenario}, sweeping {key}")
+    if args.plot:
+        experiment.sweep_plot(rows, key, values, args.plot)
+        print(f"plot: {args.plot}")
     return 0
 
 
@@ -93,14 +107,31 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="mtt-sim", description="A Gymnasium environment for video multi-target tracking.")
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="scenarios with their env ids and one-line descriptions").set_defaults(func=cmd_list)
-    run = sub.add_parser("run", help="run one episode and print a summary", description="Run one episode. " + ECHO_NOTE)
+    run = sub.add_parser("run", help="run one episode with a tracker and print its metrics")
     run.add_argument("scenario", help="scenario key (see `mtt-sim list`) or a .toml file")
+    run.add_argument("--tracker", default="sort", help="tracker spec, e.g. sort or 'sort:max_age=3' (default: sort)")
     run.add_argument("--seed", type=int, default=0)
     run.add_argument("--steps", type=int, default=0, help="at most this many steps (default: the scenario's env.max_steps)")
     run.add_argument("--video", help="write an annotated video (.mp4 or .avi)")
     run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides, e.g. sensor.clutter_rate=5")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.set_defaults(func=cmd_run)
+    for name, func, text in (("bench", cmd_bench, "a tracker x scenario x seed grid, as a table of mean and 95% interval"),
+                             ("sweep", cmd_sweep, "a stress curve: one scenario, one parameter over several values")):
+        g = sub.add_parser(name, help=text)
+        if name == "bench":
+            g.add_argument("--scenarios", required=True, help="comma-separated scenario keys")
+        else:
+            g.add_argument("scenario")
+            g.add_argument("--param", required=True, metavar="KEY=V1,V2,...", help="e.g. sensor.clutter_rate=0,2,5,10,20")
+            g.add_argument("--plot", help="write the curve as a PNG (needs the [plot] extra: matplotlib)")
+        g.add_argument("--trackers", required=True, help="comma-separated tracker specs, e.g. sort,iou,'gnn:coast=true'")
+        g.add_argument("--seeds", type=int, default=5, help="seeds 0..N-1 (default 5)")
+        g.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
+        g.add_argument("--metric", default="MOTA", help="metric of the table (default MOTA)")
+        g.add_argument("--out", help="write every episode's record (.csv, or .json)")
+        g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")
+        g.set_defaults(func=func)
     pf = sub.add_parser("perf", help="env steps/s and metrics cost at 20 and 200 targets, each against a same-run reference")
     pf.add_argument("--repeats", type=int, default=5)
     pf.add_argument("--steps", type=int, default=200)
@@ -116,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (scenario.ConfigError, OSError) as err:
+    except (ValueError, OSError, ImportError) as err:  # bad configs, specs, values, files, a missing extra
         print(f"mtt-sim: error: {err}", file=sys.stderr)
         return 2
 

@@ -116,6 +116,7 @@ class TrackingEnv(gym.Env):
         self.steps = 0
         self._done = False
         self._trails: dict[int, deque] = {}
+        self._remembered_at = -1
         self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4), np.float32))
         obs = self.observe()
         seen = self.truth.visibility > 0
@@ -135,7 +136,7 @@ class TrackingEnv(gym.Env):
         if self._done:
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
-        self._remember(ids, boxes)
+        self.remember_tracks(ids, boxes)
         scored = self.truth.visibility >= self.scenario.scoring.min_visibility
         stats = self.metrics.update(self.truth.ids[scored], self.truth.boxes[scored], ids, boxes)
         reward = self._reward(stats)
@@ -217,8 +218,13 @@ class TrackingEnv(gym.Env):
             raise ActionError(f"action['ids'] must be unique within a frame; repeated: {uniq[counts > 1].tolist()}")
         return ids.astype(np.int64), boxes.astype(np.float32)
 
-    def _remember(self, ids, boxes):
-        """Keep the last tracks and short trails of their centres for the overlay."""
+    def remember_tracks(self, ids, boxes):
+        """The tracks to draw on the current frame, and their trails (step() records its action's tracks
+        itself, unless they were given here first for this frame, e.g. to render before stepping)."""
+        if self._remembered_at == self.steps:
+            return
+        self._remembered_at = self.steps
+        ids, boxes = np.asarray(ids, np.int64), np.asarray(boxes, np.float32).reshape(-1, 4)
         self._last_tracks = (ids, boxes)
         centres = boxes[:, :2] + boxes[:, 2:] / 2
         for i, c in zip(ids.tolist(), centres):

@@ -40,6 +40,30 @@ def draw_overlay(frame: np.ndarray, truth: Truth, detections: np.ndarray, track_
     return img
 
 
+def draw_debug(img: np.ndarray, primitives: list[dict]) -> np.ndarray:
+    """Draw a tracker's `debug()` primitives on `img` in place and return it. Each is a dict with "kind":
+    "ellipse" (center, axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h) or "text" (xy, text);
+    optional "color" (RGB)."""
+    for p in primitives:
+        color = tuple(int(c) for c in p.get("color", (255, 255, 255)))
+        kind = p.get("kind")
+        if kind == "ellipse":
+            center = tuple(int(round(v)) for v in p["center"])
+            axes = tuple(max(int(round(v)), 1) for v in p["axes"])
+            cv2.ellipse(img, center, axes, float(p.get("angle", 0.0)), 0, 360, color, 1, cv2.LINE_AA)
+        elif kind == "points":
+            for x, y in np.round(np.asarray(p["xy"], float).reshape(-1, 2)).astype(int).tolist():
+                cv2.circle(img, (x, y), 1, color, -1)
+        elif kind == "box":
+            _rect(img, p["box"], color)
+        elif kind == "text":
+            x, y = (int(round(v)) for v in p["xy"])
+            cv2.putText(img, str(p["text"]), (x, y), cv2.FONT_HERSHEY_SIMPLEX, 0.35, color, 1, cv2.LINE_AA)
+        else:
+            raise ValueError(f"debug primitive kind {kind!r}: allowed: 'ellipse', 'points', 'box', 'text'")
+    return img
+
+
 class VideoWriter:
     """MP4 (mp4v) or AVI (MJPG) writer taking RGB frames; the codec follows the file extension."""
 

@@ -1,5 +1,6 @@
 """The mtt-sim command."""
 
+import csv
 import json
 import subprocess
 import sys
@@ -22,20 +23,41 @@ def test_list_names_every_scenario_with_its_env_id():
 
 def test_run_prints_a_summary_and_writes_a_video(tmp_path, capsys):
     video = tmp_path / "out.mp4"
-    assert cli.main(["run", "crossing", "--seed", "0", "--steps", "30", "--video", str(video),
+    assert cli.main(["run", "crossing", "--tracker", "gnn", "--seed", "0", "--steps", "30", "--video", str(video),
                      "--config", "sensor.clutter_rate=2"]) == 0
     text = capsys.readouterr().out
-    assert "echoes each frame's detections" in text and "MOTA" in text and "HOTA" in text
+    assert "MOTA" in text and "HOTA" in text and "tracker_fps" in text
     cap = cv2.VideoCapture(str(video))
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 30 and int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)) == 384
 
 
 def test_run_json_is_deterministic(capsys):
-    cli.main(["run", "clutter_storm", "--steps", "20", "--json"])
-    first = capsys.readouterr().out
-    cli.main(["run", "clutter_storm", "--steps", "20", "--json"])
-    assert json.loads(first) == json.loads(capsys.readouterr().out)
-    assert json.loads(first)["num_frames"] == 20
+    cli.main(["run", "clutter_storm", "--tracker", "sort", "--steps", "20", "--json"])
+    first = json.loads(capsys.readouterr().out)
+    cli.main(["run", "clutter_storm", "--tracker", "sort", "--steps", "20", "--json"])
+    again = json.loads(capsys.readouterr().out)
+    drop = ("tracker_fps", "env_fps")
+    assert {k: v for k, v in first.items() if k not in drop} == {k: v for k, v in again.items() if k not in drop}
+    assert first["num_frames"] == 20
+
+
+def test_bench_table_and_records(tmp_path, capsys):
+    out = tmp_path / "r.csv"
+    assert cli.main(["bench", "--trackers", "sort,iou", "--scenarios", "clutter_storm,books", "--seeds", "2",
+                     "--config", "env.max_steps=15", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "| tracker | clutter_storm | books | tracker frames/s |" in text and "| sort | " in text
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 8 and {r["tracker"] for r in rows} == {"sort", "iou"} and "MOTA" in rows[0]
+
+
+def test_sweep_without_matplotlib_says_how_to_install(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    code = cli.main(["sweep", "clutter_storm", "--param", "sensor.clutter_rate=0,10", "--trackers", "sort",
+                     "--seeds", "1", "--config", "env.max_steps=10", "--plot", str(tmp_path / "p.png")])
+    captured = capsys.readouterr()
+    assert "clutter_rate=0" in captured.out and "clutter_rate=10" in captured.out
+    assert code == 2 and "pip install 'mtt-sim[plot]'" in captured.err
 
 
 def test_errors_are_one_line_with_exit_code_two():
@@ -61,3 +83,10 @@ def test_config_reference_and_perf_report_shape(capsys):
     rows = perf.measure_metrics(repeats=1)
     assert [r["objects"] for r in rows] == [20, 200] and all(r["update_us"] > 0 and r["summary_s"] > 0 for r in rows)
     assert "update / reference" in perf.report_metrics(rows)
+
+
+def test_sweep_writes_a_plot(tmp_path, capsys):
+    plot = tmp_path / "curve.png"
+    assert cli.main(["sweep", "clutter_storm", "--param", "sensor.clutter_rate=0,20", "--trackers", "sort,iou",
+                     "--seeds", "2", "--config", "env.max_steps=10", "--plot", str(plot)]) == 0
+    assert plot.stat().st_size > 1000 and cv2.imread(str(plot)).shape[2] == 3

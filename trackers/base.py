@@ -65,6 +65,7 @@ class Tracker:
     name = "tracker"
     description = ""
     defaults: dict[str, Any] = {}
+    needs_frame = False  # True for trackers that read the video frame (appearance models)
 
     def __init__(self, **params):
         unknown = sorted(set(params) - set(self.defaults))
@@ -80,7 +81,9 @@ class Tracker:
         raise NotImplementedError
 
     def debug(self) -> list[dict]:
-        """Drawable internals for overlays (gates, particles, probabilities); may be empty."""
+        """Drawable internals of the last update for overlays, as plain dicts with a "kind": "ellipse" (center,
+        axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h) or "text" (xy, text), and an
+        optional RGB "color". May be empty."""
         return []
 
 
