@@ -47,10 +47,10 @@ def cmd_run(args) -> int:
     return 0
 
 
-def _grid_output(args, records, rows, title=""):
+def _grid_output(args, records, tables):
     if args.out:
         experiment.write_records(records, args.out)
-    print(experiment.markdown(rows, title))
+    print("\n\n".join(tables))
     if args.out:
         print(f"\nrecords: {args.out}")
 
@@ -58,7 +58,7 @@ def _grid_output(args, records, rows, title=""):
 def cmd_bench(args) -> int:
     records = experiment.run_grid(args.trackers.split(","), args.scenarios.split(","), args.seeds,
                                   config=parse_overrides(args.config), workers=args.workers, progress=True)
-    _grid_output(args, records, experiment.summarize(records, args.metric))
+    _grid_output(args, records, [experiment.markdown(experiment.summarize(records, m)) for m in args.metric.split(",")])
     return 0
 
 
@@ -70,13 +70,16 @@ def cmd_sweep(args) -> int:
     records = experiment.run_grid(args.trackers.split(","), [args.scenario], args.seeds,
                                   config=parse_overrides(args.config), configs=[{key: v} for v in values],
                                   workers=args.workers, progress=True)
-    rows = experiment.summarize(records, args.metric, by="config")
-    for r in rows:
-        r["column"] = f"{key.split('.')[-1]}={json.loads(r['column'])[key]}"
-    _grid_output(args, records, rows, f"{args.scenario}, sweeping {key}")
+    tables = []
+    for metric in args.metric.split(","):
+        rows = experiment.summarize(records, metric, by="config")
+        for r in rows:
+            r["column"] = f"{key.split('.')[-1]}={json.loads(r['column'])[key]}"
+        tables.append(experiment.markdown(rows, f"{args.scenario}, sweeping {key}"))
+    _grid_output(args, records, tables)
     if args.plot:
         experiment.sweep_plot(rows, key, values, args.plot)
-        print(f"plot: {args.plot}")
+        print(f"plot: {args.plot} ({metric})")
     return 0
 
 
@@ -128,7 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
         g.add_argument("--trackers", required=True, help="comma-separated tracker specs, e.g. sort,iou,'gnn:coast=true'")
         g.add_argument("--seeds", type=int, default=5, help="seeds 0..N-1 (default 5)")
         g.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
-        g.add_argument("--metric", default="MOTA", help="metric of the table (default MOTA)")
+        g.add_argument("--metric", default="MOTA", help="metric(s) of the tables, comma-separated (default MOTA)")
         g.add_argument("--out", help="write every episode's record (.csv, or .json)")
         g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")
         g.set_defaults(func=func)

@@ -133,17 +133,17 @@ def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario
 
 
 def markdown(rows: Sequence[dict], title: str = "") -> str:
-    """Trackers x columns table of mean ± 95 % interval, with each tracker's median tracker-only frames/s."""
+    """Trackers x columns table of mean ± 95 % interval, with median frames/s of tracker time and of env time."""
     trackers_, columns = list(dict.fromkeys(r["tracker"] for r in rows)), list(dict.fromkeys(r["column"] for r in rows))
     cell = {(r["tracker"], r["column"]): r for r in rows}
     metric, n = rows[0]["metric"], rows[0]["n"]
     head = f"{metric} (mean ± 95% interval over {n} seeds)" + (f", {title}" if title else "")
-    lines = [head, "", "| tracker | " + " | ".join(columns) + " | tracker frames/s |",
-             "|---|" + "---:|" * (len(columns) + 1)]
+    lines = [head, "", "| tracker | " + " | ".join(columns) + " | tracker frames/s | env frames/s |",
+             "|---|" + "---:|" * (len(columns) + 2)]
     for t in trackers_:
         values = [f"{cell[t, c]['mean']:.3f} ± {cell[t, c]['ci95']:.3f}" if (t, c) in cell else "" for c in columns]
-        fps = np.median([cell[t, c]["tracker_fps"] for c in columns if (t, c) in cell])
-        lines.append(f"| {t} | " + " | ".join(values) + f" | {fps:.0f} |")
+        fps, env_fps = (np.median([cell[t, c][k] for c in columns if (t, c) in cell]) for k in ("tracker_fps", "env_fps"))
+        lines.append(f"| {t} | " + " | ".join(values) + f" | {fps:.0f} | {env_fps:.0f} |")
     return "\n".join(lines)
 
 

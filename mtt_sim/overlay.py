@@ -17,6 +17,20 @@ def _rect(img, box, color, thickness=1):
     cv2.rectangle(img, (x, y), (x + w - 1, y + h - 1), color, thickness, cv2.LINE_AA)
 
 
+def _dashed_rect(img, box, color, dash: int = 4):
+    """A rectangle outline drawn in dashes (detections, so tracks drawn over them stay readable)."""
+    x, y, w, h = (int(round(v)) for v in box[:4])
+    x1, y1 = x + w - 1, y + h - 1
+    for a in range(x, x1 + 1, 2 * dash):
+        b = min(a + dash - 1, x1)
+        cv2.line(img, (a, y), (b, y), color, 1)
+        cv2.line(img, (a, y1), (b, y1), color, 1)
+    for a in range(y, y1 + 1, 2 * dash):
+        b = min(a + dash - 1, y1)
+        cv2.line(img, (x, a), (x, b), color, 1)
+        cv2.line(img, (x1, a), (x1, b), color, 1)
+
+
 def track_color(track_id: int) -> tuple[int, ...]:
     """A stable, well-separated colour per track id."""
     return tuple(int(c) for c in hue_colors(np.array([0.618034 * track_id]))[0])
@@ -24,12 +38,13 @@ def track_color(track_id: int) -> tuple[int, ...]:
 
 def draw_overlay(frame: np.ndarray, truth: Truth, detections: np.ndarray, track_ids: np.ndarray,
                  track_boxes: np.ndarray, trails: dict | None = None) -> np.ndarray:
-    """A copy of `frame` with truth (green, dashed where mostly hidden), detections (yellow) and tracks (per-id colour)."""
+    """A copy of `frame` with truth (thin green, dark where mostly hidden), detections (dashed yellow) and tracks
+    (per-id colour, id label, short trail of centres)."""
     img = frame.copy()
     for box, vis in zip(truth.boxes, truth.visibility):
         _rect(img, box, GT_COLOR if vis >= 0.5 else (20, 110, 20))
     for det in detections:
-        _rect(img, det, DET_COLOR)
+        _dashed_rect(img, det, DET_COLOR)
     for tid, box in zip(track_ids.tolist(), track_boxes):
         color = track_color(tid)
         _rect(img, box, color, 2)

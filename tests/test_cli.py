@@ -46,7 +46,7 @@ def test_bench_table_and_records(tmp_path, capsys):
     assert cli.main(["bench", "--trackers", "sort,iou", "--scenarios", "clutter_storm,books", "--seeds", "2",
                      "--config", "env.max_steps=15", "--out", str(out)]) == 0
     text = capsys.readouterr().out
-    assert "| tracker | clutter_storm | books | tracker frames/s |" in text and "| sort | " in text
+    assert "| tracker | clutter_storm | books | tracker frames/s | env frames/s |" in text and "| sort | " in text
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 8 and {r["tracker"] for r in rows} == {"sort", "iou"} and "MOTA" in rows[0]
 

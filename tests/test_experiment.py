@@ -40,6 +40,6 @@ def test_summarize_and_markdown():
     rows = experiment.summarize(records, "MOTA")
     assert [(r["tracker"], round(r["mean"], 6), r["n"]) for r in rows] == [("a", 0.6, 2), ("b", 0.1, 2)]
     table = experiment.markdown(rows)
-    assert "| a | 0.600 ± " in table and "| b | 0.100 ± 0.000 | 100 |" in table
+    assert "| a | 0.600 ± " in table and "| b | 0.100 ± 0.000 | 100 | 1 |" in table
     with pytest.raises(ValueError, match="unknown metric 'MOTX'"):
         experiment.summarize(records, "MOTX")
