@@ -32,5 +32,5 @@ def placed(sc: scenario.Scenario, positions, seed=0) -> TrackingEnv:
     env = TrackingEnv(sc)
     env.reset(seed=seed)
     env.world.place(np.asarray(positions, float))
-    env.last_obs = env.observe()
+    env.observe()
     return env

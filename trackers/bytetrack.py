@@ -6,7 +6,7 @@ import numpy as np
 
 from .assignment import assign, iou_matrix
 from .base import Tracker, Tracks, detections, register
-from .kalman import KalmanBank, box_model, boxes_to_z, z_to_boxes
+from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
 from .trackbook import CONFIRMED, LOST, TENTATIVE, TrackBook
 
 
@@ -45,8 +45,8 @@ class ByteTrack(Tracker):
         self.frame += 1
         high = dets[dets[:, 4] >= p["track_thresh"]]
         low = dets[(dets[:, 4] >= p["low_thresh"]) & (dets[:, 4] < p["track_thresh"])]
+        stop_shrinking_to_nothing(book.kf)
         book.predict()
-        book.kf.x[book.kf.x[:, 2] + book.kf.x[:, 6] <= 0, 6] = 0.0
         free_high, free_low = np.ones(len(high), bool), np.ones(len(low), bool)
         pool = np.flatnonzero(book.state != TENTATIVE)
         first = self._match(pool, high, free_high, p["match_thresh"])

@@ -44,6 +44,11 @@ def point_model(accel_sigma: float = 1.0, meas_sigma: float = 2.0, vel_sigma0: f
                  np.diag([meas_sigma**2, meas_sigma**2, vel_sigma0**2, vel_sigma0**2]))
 
 
+def stop_shrinking_to_nothing(bank: "KalmanBank") -> None:
+    """Box model: zero the area velocity where the next prediction would make the area negative (as SORT does)."""
+    bank.x[bank.x[:, 2] + bank.x[:, 6] <= 0, 6] = 0.0
+
+
 def boxes_to_z(boxes: np.ndarray) -> np.ndarray:
     """x, y, w, h -> SORT's measurement cx, cy, s, r."""
     boxes = np.asarray(boxes, float).reshape(-1, 4)

@@ -6,7 +6,7 @@ import numpy as np
 
 from .assignment import assign, iou_matrix
 from .base import Tracker, Tracks, detections, register
-from .kalman import KalmanBank, box_model, boxes_to_z, z_to_boxes
+from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
 from .trackbook import TrackBook
 
 
@@ -31,10 +31,8 @@ class Sort(Tracker):
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["min_confidence"]]
         self.frame += 1
+        stop_shrinking_to_nothing(book.kf)
         book.predict()
-        # the area velocity must not drive the area negative (as in the reference code)
-        shrinking = book.kf.x[:, 2] + book.kf.x[:, 6] <= 0
-        book.kf.x[shrinking, 6] = 0.0
         predicted = z_to_boxes(book.kf.x)
         matches, _, new = assign(-iou_matrix(predicted, dets[:, :4]), -p["iou_threshold"])
         book.hit(matches[:, 0], dets[matches[:, 1], :4], dets[matches[:, 1], 4], boxes_to_z(dets[matches[:, 1], :4]))
