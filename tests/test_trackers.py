@@ -164,3 +164,10 @@ def test_gated_assignment():
     matches, rows, cols = assign(np.zeros((0, 3)), 1.0)
     assert len(matches) == 0 and cols.tolist() == [0, 1, 2]
     np.testing.assert_allclose(iou_matrix([[0, 0, 10, 10]], [[5, 0, 10, 10], [20, 20, 1, 1]]), [[50 / 150, 0]])
+
+
+def test_trackers_never_import_the_simulator():
+    import subprocess
+    import sys
+    code = "import sys, trackers; bad = [m for m in sys.modules if m.startswith('mtt_sim')]; assert not bad, bad"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True).returncode == 0
