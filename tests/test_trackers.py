@@ -171,3 +171,43 @@ def test_trackers_never_import_the_simulator():
     import sys
     code = "import sys, trackers; bad = [m for m in sys.modules if m.startswith('mtt_sim')]; assert not bad, bad"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True).returncode == 0
+
+
+# ------------------------------------------------------------------ Murty's k-best assignments
+
+from itertools import permutations  # noqa: E402
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from trackers.assignment import murty  # noqa: E402
+
+
+@st.composite
+def cost_matrices(draw):
+    n = draw(st.integers(0, 4))
+    m = draw(st.integers(max(n, 1), 5))
+    values = st.sampled_from([0.0, 1.0, 1.0, 2.0, 3.5, 7.0, np.inf])  # repeated values make ties
+    return np.array([[draw(values) for _ in range(m)] for _ in range(n)]).reshape(n, m)
+
+
+@settings(max_examples=300, deadline=None)
+@given(cost_matrices(), st.integers(1, 40))
+def test_murty_matches_brute_force_enumeration(cost, k):
+    n, m = cost.shape
+    feasible = sorted(sum(cost[r, c] for r, c in enumerate(p)) for p in permutations(range(m), n)
+                      if all(np.isfinite(cost[r, c]) for r, c in enumerate(p)))
+    got = murty(cost, k)
+    assert [c for _, c in got] == pytest.approx(feasible[:k])  # ascending, the k best, fewer if fewer exist
+    assert len({tuple(cols.tolist()) for cols, _ in got}) == len(got)  # distinct assignments
+    for cols, total in got:
+        assert len(set(cols.tolist())) == n and cost[np.arange(n), cols].sum() == pytest.approx(total)
+
+
+def test_murty_edge_cases():
+    assert murty(np.array([[np.inf, np.inf]]), 3) == []
+    assert murty(np.zeros((0, 2)), 2)[0][1] == 0.0
+    with pytest.raises(ValueError, match=r"n <= m"):
+        murty(np.zeros((3, 2)), 1)
+    with pytest.raises(ValueError, match="NaN"):
+        murty(np.array([[np.nan, 1.0]]), 1)

@@ -1,6 +1,8 @@
-"""Association: IoU and gated Hungarian assignment (scipy's linear_sum_assignment)."""
+"""Association: IoU, chi-square gates, gated Hungarian assignment and Murty's k-best assignments (scipy)."""
 
 from __future__ import annotations
+
+import heapq
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -37,3 +39,54 @@ def assign(cost: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray, n
     else:
         rows = cols = np.zeros(0, np.intp)
     return (np.stack([rows, cols], axis=1), np.setdiff1d(np.arange(n), rows), np.setdiff1d(np.arange(m), cols))
+
+
+def _best(cost: np.ndarray) -> np.ndarray | None:
+    """The minimum-cost full row assignment of `cost` (inf = forbidden), or None if none is feasible."""
+    try:
+        rows, cols = linear_sum_assignment(cost)
+    except ValueError:  # scipy: "cost matrix is infeasible"
+        return None
+    return cols if np.isfinite(cost[rows, cols]).all() else None
+
+
+def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
+    """The k lowest-cost assignments of every row of `cost` (n, m), n <= m, to a distinct column.
+
+    Murty's algorithm (as used by Cox and Hingorani 1996): the best assignment's solution space is
+    partitioned into subproblems, each forcing the solution's first i pairs and forbidding pair i;
+    the cheapest open subproblem gives the next assignment. np.inf marks forbidden pairs. Returns
+    (cols, total cost) pairs in ascending order of cost; fewer than k if fewer are feasible.
+    """
+    cost = np.asarray(cost, float)
+    if cost.ndim != 2 or cost.shape[0] > cost.shape[1]:
+        raise ValueError(f"murty: cost must be (n, m) with n <= m, got shape {cost.shape}")
+    if np.isnan(cost).any() or (cost == -np.inf).any():
+        raise ValueError("murty: cost must not contain NaN or -inf (use +inf for forbidden pairs)")
+    n = cost.shape[0]
+    if k <= 0:
+        return []
+    if n == 0:
+        return [(np.zeros(0, np.intp), 0.0)]
+    first = _best(cost)
+    if first is None:
+        return []
+    rows = np.arange(n)
+    heap = [(float(cost[rows, first].sum()), 0, first, cost)]
+    out, counter = [], 1
+    while heap and len(out) < k:
+        total, _, cols, node = heapq.heappop(heap)
+        out.append((cols, total))
+        forced = node.copy()
+        for i in range(n):
+            if np.isfinite(forced[i]).sum() > 1:  # a row already forced to one column has no alternative
+                child = forced.copy()
+                child[i, cols[i]] = np.inf
+                sol = _best(child)
+                if sol is not None:
+                    heapq.heappush(heap, (float(cost[rows, sol].sum()), counter, sol, child))
+                    counter += 1
+            keep = forced[i, cols[i]]
+            forced[i, :], forced[:, cols[i]] = np.inf, np.inf
+            forced[i, cols[i]] = keep
+    return out
