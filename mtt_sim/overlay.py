@@ -57,8 +57,8 @@ def draw_overlay(frame: np.ndarray, truth: Truth, detections: np.ndarray, track_
 
 def draw_debug(img: np.ndarray, primitives: list[dict]) -> np.ndarray:
     """Draw a tracker's `debug()` primitives on `img` in place and return it. Each is a dict with "kind":
-    "ellipse" (center, axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h) or "text" (xy, text);
-    optional "color" (RGB)."""
+    "ellipse" (center, axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h), "text" (xy, text)
+    or "data" (not drawn); optional "color" (RGB)."""
     for p in primitives:
         color = tuple(int(c) for c in p.get("color", (255, 255, 255)))
         kind = p.get("kind")
@@ -71,11 +71,13 @@ def draw_debug(img: np.ndarray, primitives: list[dict]) -> np.ndarray:
                 cv2.circle(img, (x, y), 1, color, -1)
         elif kind == "box":
             _rect(img, p["box"], color)
+        elif kind == "data":  # values for inspection (a validation matrix, probabilities), nothing to draw
+            continue
         elif kind == "text":
             x, y = (int(round(v)) for v in p["xy"])
             cv2.putText(img, str(p["text"]), (x, y), cv2.FONT_HERSHEY_SIMPLEX, 0.35, color, 1, cv2.LINE_AA)
         else:
-            raise ValueError(f"debug primitive kind {kind!r}: allowed: 'ellipse', 'points', 'box', 'text'")
+            raise ValueError(f"debug primitive kind {kind!r}: allowed: 'ellipse', 'points', 'box', 'text', 'data'")
     return img
 
 

@@ -82,3 +82,87 @@ def test_bad_inputs():
         association_probabilities(np.ones((1, 1)), 0.9, 1.0, k=0)
     with pytest.raises(ValueError, match="no joint event"):
         association_probabilities(np.zeros((1, 1)), 1.0, 1.0)
+
+
+# ------------------------------------------------------------------ motion situations and the tracker
+
+import trackers  # noqa: E402
+from trackers.jpda import NEW, NORMAL, OCCLUDED, REVIVED, SPLIT, VANISHED, situations  # noqa: E402
+
+
+def test_situations_from_beta_prime():
+    # rows: measurements z0..z4; columns: targets t0..t4
+    b = np.zeros((5, 5))
+    b[0, 0] = 0.9            # t0 normal: z0 is its only measurement and z0 is only t0's
+    b[1, 1] = b[2, 1] = 0.4  # t1 split into z1 and z2
+    b[3, 2] = 0.6            # t2 and t3 merged into z3: occluded (Table 1's row with several positive entries)
+    b[3, 3] = 2.8e-8
+    # t4: no measurement -> vanished; z4: no target -> new
+    situ, new = situations(b)
+    assert situ == [NORMAL, SPLIT, OCCLUDED, OCCLUDED, VANISHED] and new.tolist() == [4]
+
+
+def frames(paths, k_max):
+    """Observations from per-target centre paths (None = not detected that frame); boxes 10 x 20."""
+    for k in range(k_max):
+        rows = [(x - 5, y - 10, 10, 20, 0.9) for p in paths if (c := p(k)) is not None for x, y in [c]]
+        dets = np.zeros((8, 5), np.float32)
+        dets[: len(rows)] = np.array(rows, np.float32).reshape(-1, 5)
+        yield {"detections": dets, "num_detections": len(rows)}
+
+
+def run(paths, k_max, **params):
+    t = trackers.make("jpda", **params)
+    t.reset({})
+    return t, [(tr.ids.tolist(), list(t.last["situations"])) for tr in map(t.update, frames(paths, k_max))]
+
+
+def test_new_then_normal_then_vanished_and_ended_after_three_misses():
+    a = lambda k: (20 + 2 * k, 50) if k < 10 else None  # noqa: E731
+    t, out = run([a], 16)
+    assert out[0] == ([1], [NEW]) and out[5] == ([1], [NORMAL])
+    assert [o[1] for o in out[10:13]] == [[VANISHED]] * 3 and all(o[0] == [] for o in out[10:])
+    assert len(t.ids) == 0 and t.ended["ids"].tolist() == [1]
+
+
+def test_a_target_reappearing_soon_is_revived_with_its_id():
+    a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 14 else None  # noqa: E731 (4 frames missed: ended, then back)
+    t, out = run([a], 20)
+    assert out[13][0] == [] and out[14] == ([1], [REVIVED])
+    assert t.next_id == 2  # no new target was started
+
+
+def test_a_target_reappearing_too_late_is_new():
+    a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 20 else None  # noqa: E731
+    t, out = run([a], 24)
+    assert out[20][0] == [2] and out[20][1] == [NEW]
+
+
+def test_fragments_of_one_target_are_a_split_and_update_it():
+    def halves(sign):
+        return lambda k: (20 + 2 * k, 50 + sign * 4) if k >= 10 else ((20 + 2 * k, 50) if sign > 0 else None)
+    t, out = run([halves(1), halves(-1)], 14)
+    assert out[10][1] == [SPLIT] and out[12][0] == [1]  # one target, not two
+    assert abs(t.kf.x[0, 1] - 50) < 2  # the combined update sits between the fragments
+
+
+def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
+    a = lambda k: (20 + 2 * k, 50) if k < 8 else (None if k < 12 else (20 + 2 * k, 50))  # noqa: E731
+    b = lambda k: (20 + 2 * k, 80) if k < 8 else ((20 + 2 * k, 65) if k < 12 else (20 + 2 * k, 80))  # noqa: E731
+    t, out = run([a, b], 9, meas_sigma=8.0)
+    assert out[8][1] == [OCCLUDED, OCCLUDED] and sorted(out[8][0]) == [1, 2]
+    np.testing.assert_allclose(t.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
+    np.testing.assert_allclose(t.kf.x[:, 2:], 0.0)
+
+
+def test_jpda_exact_uses_every_joint_event():
+    exact, approx = trackers.make("jpda_exact"), trackers.make("jpda")
+    assert exact._k(3, 4) is None and approx._k(3, 4) == 7 and exact._k(9, 9) == 5000
+
+
+@pytest.mark.parametrize("name", ["jpda", "jpda_exact"])
+def test_end_to_end_through_gym_make(name):
+    from test_trackers import EASY, run_episode
+    assert run_episode(name, "mtt_sim/ClutterStorm-v0", EASY)["MOTA"] >= 0.95
+    m = run_episode(name, "mtt_sim/Soccer-v0", {"env.max_steps": 30})
+    assert m["num_frames"] == 30 and m["TP"] > 0

@@ -12,8 +12,12 @@ assignment problem whose cost is -log of those factors, with one dummy "missed" 
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
-from .assignment import murty
+from .assignment import chi2_gate, murty
+from .base import Tracker, Tracks, detections, register
+from .kalman import KalmanBank, point_model
 
 
 def _factors(g, pd, clutter_density) -> tuple[np.ndarray, np.ndarray]:
@@ -79,3 +83,224 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
     for chosen, weight in events:
         beta[rows, np.asarray(chosen, int) + 1] += weight
     return beta / total
+
+
+# ------------------------------------------------------------------ the tracker
+
+NORMAL, NEW, VANISHED, OCCLUDED, SPLIT, REVIVED = "normal", "new", "vanished", "occluded", "split", "revived"
+
+
+def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cluster labels of targets (rows) and measurements (columns) linked by gated pairs (connected components)."""
+    n, m = gated.shape
+    rows, cols = np.nonzero(gated)
+    graph = coo_matrix((np.ones(len(rows)), (rows, n + cols)), shape=(n + m, n + m))
+    labels = connected_components(graph, directed=False)[1]
+    return labels[:n], labels[n:]
+
+
+def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Each target's motion situation from beta' (measurements x targets), and the measurements left unexplained.
+
+    Section 5 of the paper: a column with one positive entry whose row has no other is NORMAL; an all-zero column is
+    VANISHED; a column with several positive entries is SPLIT (fragments; the JPDA update stands); a target whose
+    only positive entry lies in a row shared with other such targets is OCCLUDED (merged into one blob: the paper's
+    "row with several positive entries", read as Fig. 5(c)'s merge so that targets whose gates merely overlap keep
+    the JPDA update). An all-zero row is a NEW candidate.
+    """
+    positive = beta_prime > 0
+    per_col, per_row = positive.sum(axis=0), positive.sum(axis=1)
+    first = np.argmax(positive, axis=0) if len(positive) else np.zeros(positive.shape[1], int)
+    only = np.where(per_col == 1, first, -1)  # a target's single measurement
+    sharing = np.bincount(only[only >= 0], minlength=len(beta_prime))
+    out = []
+    for t in range(beta_prime.shape[1]):
+        if per_col[t] == 0:
+            out.append(VANISHED)
+        elif per_col[t] > 1:
+            out.append(SPLIT)
+        elif sharing[only[t]] > 1:
+            out.append(OCCLUDED)
+        else:
+            out.append(NORMAL)  # its one measurement may be shared with targets that have others: plain JPDA
+    return out, np.flatnonzero(per_row == 0)
+
+
+@register
+class Jpda(Tracker):
+    """Seed 000: each target's box centre is Kalman-filtered with a constant-velocity model; measurements (detection
+    centres) within the gate d^2 <= chi2(gate_probability, 2) form the validation matrix; targets sharing
+    measurements are clustered; in each cluster the joint-event probabilities (P_D, clutter density) give beta from
+    the K most probable events found by Murty (K = targets + measurements, as in the paper) and the JPDA update
+    combines all gated measurements. beta' then classifies each target (normal, new, vanished, occluded, split):
+    occluded targets jump to the shared measurement with zero velocity; a target vanished for vanish_frames frames is
+    ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
+    targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
+    last size. Reported: targets that had a measurement this frame."""
+
+    name = "jpda"
+    description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
+    defaults = {"pd": 0.9, "clutter_density": 1e-5, "gate_probability": 0.99, "k": 0, "vanish_frames": 3,
+                "revive_frames": 5, "accel_sigma": 0.5, "meas_sigma": 4.0, "min_confidence": 0.0}
+    exact = False  # jpda_exact enumerates every joint event instead
+
+    def reset(self, info=None):
+        p = self.params
+        self.model = point_model(p["accel_sigma"], p["meas_sigma"])
+        self.kf = KalmanBank(self.model)
+        self.ids, self.misses, self.sizes = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 2))
+        self.ended = {"ids": np.zeros(0, np.int64), "age": np.zeros(0, np.int64), "sizes": np.zeros((0, 2)),
+                      "bank": KalmanBank(self.model)}
+        self.next_id = 1
+        self.gate = chi2_gate(2, p["gate_probability"])
+        self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool), "gates": []}
+
+    # -------------------------------------------------------------- one frame
+
+    def update(self, obs) -> Tracks:
+        p = self.params
+        dets = detections(obs)
+        dets = dets[dets[:, 4] >= p["min_confidence"]]
+        z = dets[:, :2] + dets[:, 2:4] / 2
+        self.kf.predict()
+        self.ended["bank"].predict()
+        self.ended["age"] += 1
+        beta, gated = self._associate(z)
+        situ, unexplained = situations(beta[:, 1:].T)
+        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "gates": self._gate_shapes()}
+        self._jpda_update(beta, z)
+        best = np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int)
+        for t, s in enumerate(situ):
+            if s == OCCLUDED:  # the merged blob's centre, at rest (section 5, 4)
+                self.kf.x[t] = np.r_[z[best[t]], 0.0, 0.0]
+                self.kf.P[t] = self.model.P0
+            if s == NORMAL:
+                self.sizes[t] = dets[best[t], 2:4]
+        self.misses = np.where(np.array([s == VANISHED for s in situ], bool), self.misses + 1, 0)
+        self._end_vanished()
+        fresh = self._revive(z, dets, unexplained)
+        self._add(z[fresh], dets[fresh, 2:4])
+        self.last["situations"] += [REVIVED] * (len(self.ids) - len(situ) - len(fresh)) + [NEW] * len(fresh)
+        seen = self.misses == 0
+        centre = self.kf.x[seen, :2]
+        return Tracks.of(self.ids[seen], np.c_[centre - self.sizes[seen] / 2, self.sizes[seen]])
+
+    def _associate(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """beta (targets, 1 + measurements) cluster by cluster, and the validation (gate) matrix."""
+        p, n, m = self.params, len(self.ids), len(z)
+        beta = np.zeros((n, m + 1))
+        beta[:, 0] = 1.0
+        if not n or not m:
+            return beta, np.zeros((n, m), bool)
+        d2 = self.kf.mahalanobis(z)
+        gated = d2 <= self.gate
+        det_s = np.linalg.det(self.kf.innovation_covariance())
+        g = np.where(gated, np.exp(-0.5 * d2) / (2 * np.pi * np.sqrt(det_s))[:, None], 0.0)
+        t_label, z_label = clusters(gated)
+        for c in np.unique(t_label[gated.any(axis=1)]):
+            ti, zj = np.flatnonzero(t_label == c), np.flatnonzero(z_label == c)
+            b = association_probabilities(g[np.ix_(ti, zj)], p["pd"], p["clutter_density"], self._k(len(ti), len(zj)))
+            beta[ti, 0] = b[:, 0]
+            beta[np.ix_(ti, zj + 1)] = b[:, 1:]
+        return beta, gated
+
+    def _k(self, n_targets: int, n_measurements: int) -> int | None:
+        """How many joint events a cluster uses: the paper's K = targets + measurements unless set."""
+        return self.params["k"] or n_targets + n_measurements
+
+    def _jpda_update(self, beta: np.ndarray, z: np.ndarray) -> None:
+        """Eq. 10-12 for every target at once: the beta-weighted innovation, and the covariance with its spread."""
+        if not len(self.ids) or not len(z):
+            return
+        H, R, x, P = self.model.H, self.model.R, self.kf.x, self.kf.P
+        S = H @ P @ H.T + R
+        K = np.linalg.solve(S, H @ P).transpose(0, 2, 1)
+        nu = z[None, :, :] - (x @ H.T)[:, None, :]
+        b, b0 = beta[:, 1:], beta[:, 0]
+        combined = np.einsum("nm,nmi->ni", b, nu)
+        spread = np.einsum("nm,nmi,nmj->nij", b, nu, nu) - combined[:, :, None] * combined[:, None, :]
+        self.kf.x = x + np.einsum("nij,nj->ni", K, combined)
+        self.kf.P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
+
+    def _end_vanished(self) -> None:
+        """Targets vanished for vanish_frames frames leave the active set for the revival pool."""
+        gone = self.misses >= self.params["vanish_frames"]
+        e = self.ended
+        e["ids"] = np.r_[e["ids"], self.ids[gone]]
+        e["age"] = np.r_[e["age"], np.zeros(gone.sum(), np.int64)]
+        e["sizes"] = np.r_[e["sizes"], self.sizes[gone]]
+        e["bank"].x, e["bank"].P = np.r_[e["bank"].x, self.kf.x[gone]], np.r_[e["bank"].P, self.kf.P[gone]]
+        self._keep(~gone)
+
+    def _revive(self, z: np.ndarray, dets: np.ndarray, unexplained: np.ndarray) -> np.ndarray:
+        """Unexplained measurements that associate normally (uniquely, both ways) with a recently ended target
+        bring it back; the others are returned as new targets."""
+        e = self.ended
+        young = e["age"] <= self.params["revive_frames"]
+        for k in ("ids", "age", "sizes"):
+            e[k] = e[k][young]
+        e["bank"].keep(young)
+        if not len(unexplained) or not len(e["ids"]):
+            return unexplained
+        gated = e["bank"].mahalanobis(z[unexplained]) <= self.gate
+        unique = gated & (gated.sum(axis=0) == 1)[None, :] & (gated.sum(axis=1) == 1)[:, None]
+        rows, cols = np.nonzero(unique)
+        if len(rows):
+            e["bank"].update(rows, z[unexplained[cols]])
+            self.ids = np.r_[self.ids, e["ids"][rows]]
+            self.misses = np.r_[self.misses, np.zeros(len(rows), np.int64)]
+            self.sizes = np.r_[self.sizes, dets[unexplained[cols], 2:4]]
+            self.kf.x, self.kf.P = np.r_[self.kf.x, e["bank"].x[rows]], np.r_[self.kf.P, e["bank"].P[rows]]
+            keep = np.ones(len(e["ids"]), bool)
+            keep[rows] = False
+            for k in ("ids", "age", "sizes"):
+                e[k] = e[k][keep]
+            e["bank"].keep(keep)
+        return np.setdiff1d(unexplained, unexplained[cols])
+
+    def _add(self, z: np.ndarray, sizes: np.ndarray) -> None:
+        """New targets at the measurements, at rest (section 5, 2)."""
+        self.kf.add(z)
+        self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + len(z))]
+        self.next_id += len(z)
+        self.misses = np.r_[self.misses, np.zeros(len(z), np.int64)]
+        self.sizes = np.r_[self.sizes, sizes]
+
+    def _keep(self, mask: np.ndarray) -> None:
+        self.kf.keep(mask)
+        self.ids, self.misses, self.sizes = self.ids[mask], self.misses[mask], self.sizes[mask]
+
+    def _gate_shapes(self) -> list[dict]:
+        """Gate ellipses d^2 = gate around each target's predicted centre, with its id."""
+        out = []
+        if not len(self.ids):
+            return out
+        for tid, centre, S in zip(self.ids.tolist(), self.kf.measurement(), self.kf.innovation_covariance()):
+            val, vec = np.linalg.eigh(S)
+            out.append({"kind": "ellipse", "center": centre, "axes": np.sqrt(self.gate * val[::-1]),
+                        "angle": float(np.degrees(np.arctan2(vec[1, 1], vec[0, 1]))), "color": (0, 200, 255),
+                        "id": tid})
+        return out
+
+    def debug(self) -> list[dict]:
+        """Gate ellipses, each target's motion situation as text, and the validation matrix and beta as data."""
+        out = list(self.last["gates"])
+        for gate, situation in zip(self.last["gates"], self.last["situations"]):
+            out.append({"kind": "text", "xy": gate["center"] + np.array([6.0, -6.0]), "text": situation,
+                        "color": (255, 255, 255)})
+        out.append({"kind": "data", "validation": self.last["gated"], "beta": self.last["beta"]})
+        return out
+
+
+@register
+class JpdaExact(Jpda):
+    """Traditional JPDA, as the paper's baseline: the same filter, but every joint event of a cluster is enumerated
+    (exponential in the cluster size). Clusters of more than max_exact_targets targets fall back to the
+    max_events most probable events (Murty), so a crowd cannot stall it; that is the cap."""
+
+    name = "jpda_exact"
+    description = "Traditional JPDA: every joint event enumerated (clusters capped at max_exact_targets targets)"
+    defaults = {**Jpda.defaults, "max_exact_targets": 8, "max_events": 5000}
+
+    def _k(self, n_targets: int, n_measurements: int) -> int | None:
+        return None if n_targets <= self.params["max_exact_targets"] else self.params["max_events"]
