@@ -149,7 +149,7 @@ def test_fragments_of_one_target_are_a_split_and_update_it():
 def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
     a = lambda k: (20 + 2 * k, 50) if k < 8 else (None if k < 12 else (20 + 2 * k, 50))  # noqa: E731
     b = lambda k: (20 + 2 * k, 80) if k < 8 else ((20 + 2 * k, 65) if k < 12 else (20 + 2 * k, 80))  # noqa: E731
-    t, out = run([a, b], 9, meas_sigma=8.0)
+    t, out = run([a, b], 9, meas_sigma=8.0, occlusion_velocity="zero")  # the paper's rule: at the blob, at rest
     assert out[8][1] == [OCCLUDED, OCCLUDED] and sorted(out[8][0]) == [1, 2]
     np.testing.assert_allclose(t.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
     np.testing.assert_allclose(t.kf.x[:, 2:], 0.0)
@@ -166,3 +166,37 @@ def test_end_to_end_through_gym_make(name):
     assert run_episode(name, "mtt_sim/ClutterStorm-v0", EASY)["MOTA"] >= 0.95
     m = run_episode(name, "mtt_sim/Soccer-v0", {"env.max_steps": 30})
     assert m["num_frames"] == 30 and m["TP"] > 0
+
+
+def crossing_paths():
+    """A walks right, B left, 8 px apart vertically; for frames 9-11 the detector sees one merged blob."""
+    a = lambda k: (20 + 3 * k, 50)  # noqa: E731
+    b = lambda k: (80 - 3 * k, 58)  # noqa: E731
+    merged = range(9, 12)
+    return ([lambda k: a(k) if k not in merged else ((a(k)[0] + b(k)[0]) / 2, 54),
+             lambda k: b(k) if k not in merged else None], a, b)
+
+
+@pytest.mark.parametrize("velocity, kept", [("keep", True), ("zero", False)])
+def test_occlusion_merge_then_separation(velocity, kept):
+    paths, a, b = crossing_paths()
+    t = trackers.make("jpda", occlusion_velocity=velocity)
+    t.reset({})
+    owner = {}
+    for k, obs in enumerate(frames(paths, 20)):
+        tracks = t.update(obs)
+        if k == 9:
+            assert t.last["situations"] == [OCCLUDED, OCCLUDED]
+        centres = tracks.boxes[:, :2] + tracks.boxes[:, 2:] / 2
+        if k not in range(9, 12):
+            for tid, c in zip(tracks.ids.tolist(), centres):
+                who = "a" if np.hypot(*(c - a(k))) < np.hypot(*(c - b(k))) else "b"  # the nearer target
+                owner.setdefault(tid, set()).add(who)
+    # with each target's own velocity kept through the merge, both come out on their own side with their ids;
+    # with the paper's zero velocity they share one state and do not
+    assert (owner == {1: {"a"}, 2: {"b"}}) == kept, owner
+
+
+def test_bad_occlusion_velocity():
+    with pytest.raises(ValueError, match="occlusion_velocity='stop': allowed: 'keep', 'zero'"):
+        trackers.make("jpda:occlusion_velocity=stop")

@@ -136,13 +136,21 @@ class Jpda(Tracker):
     occluded targets jump to the shared measurement with zero velocity; a target vanished for vanish_frames frames is
     ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
-    last size. Reported: targets that had a measurement this frame."""
+    last size. Reported: targets that had a measurement this frame. situations=false drops the occlusion
+    correction and the revival (plain JPDA with births and deaths); occlusion_velocity=zero follows the paper's
+    text (see the comment in update); k=0 means the paper's K."""
 
     name = "jpda"
     description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
     defaults = {"pd": 0.9, "clutter_density": 1e-5, "gate_probability": 0.99, "k": 0, "vanish_frames": 3,
-                "revive_frames": 5, "accel_sigma": 0.5, "meas_sigma": 4.0, "min_confidence": 0.0}
-    exact = False  # jpda_exact enumerates every joint event instead
+                "revive_frames": 5, "accel_sigma": 0.5, "meas_sigma": 4.0, "min_confidence": 0.0,
+                "situations": True, "occlusion_velocity": "keep"}
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        if self.params["occlusion_velocity"] not in ("keep", "zero"):
+            raise ValueError(f"tracker {self.name!r}: occlusion_velocity={self.params['occlusion_velocity']!r}: "
+                             "allowed: 'keep', 'zero'")
 
     def reset(self, info=None):
         p = self.params
@@ -171,14 +179,18 @@ class Jpda(Tracker):
         self._jpda_update(beta, z)
         best = np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int)
         for t, s in enumerate(situ):
-            if s == OCCLUDED:  # the merged blob's centre, at rest (section 5, 4)
-                self.kf.x[t] = np.r_[z[best[t]], 0.0, 0.0]
-                self.kf.P[t] = self.model.P0
+            if s == OCCLUDED and p["situations"]:  # the merged blob's centre (section 5, 4)
+                # The paper also zeroes the velocity; then merged targets share one state and which leaves the
+                # blob as which is a coin flip. By default each keeps its own velocity, so targets that cross
+                # come out on their own sides ("zero" is the paper's text, kept for the ablation).
+                velocity = self.kf.x[t, 2:] if p["occlusion_velocity"] == "keep" else np.zeros(2)
+                self.kf.x[t] = np.r_[z[best[t]], velocity]
+                self.kf.P[t, :2, :2] = self.model.P0[:2, :2]
             if s == NORMAL:
                 self.sizes[t] = dets[best[t], 2:4]
         self.misses = np.where(np.array([s == VANISHED for s in situ], bool), self.misses + 1, 0)
         self._end_vanished()
-        fresh = self._revive(z, dets, unexplained)
+        fresh = self._revive(z, dets, unexplained) if p["situations"] else unexplained
         self._add(z[fresh], dets[fresh, 2:4])
         self.last["situations"] += [REVIVED] * (len(self.ids) - len(situ) - len(fresh)) + [NEW] * len(fresh)
         seen = self.misses == 0
