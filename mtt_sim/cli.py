@@ -95,6 +95,8 @@ def cmd_perf(args) -> int:
     print(perf.report(perf.measure(repeats=args.repeats, steps=args.steps)))
     print()
     print(perf.report_metrics(perf.measure_metrics(repeats=args.repeats)))
+    print()
+    print(perf.report_jpda(perf.measure_jpda(repeats=args.repeats)))
     return 0
 
 

@@ -25,6 +25,8 @@ Semantics, following TrackEval where other tools differ:
 - GOSPA (alpha = 2) on box centres with cut-off `c` and order `p`, computed with an exact
   assignment: (sum over assigned pairs of min(d, c)^p + c^p / 2 * (missed + false))^(1/p); the mean
   over frames is reported.
+- CentreError and CentreErrorVar: mean and variance of the distance between the box centres of the CLEAR
+  matches, pooled over targets (the error measure of seed 000's Tables 3 and 4), in pixels.
 - Similarity "iou" is the box IoU; "centroid" is TrackEval's point similarity
   max(0, 1 - d / zero_distance) on box centres.
 """
@@ -66,6 +68,11 @@ def centres(boxes: np.ndarray) -> np.ndarray:
 def centre_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Euclidean distance matrix between box centres."""
     return np.linalg.norm(centres(a)[:, None] - centres(b)[None], axis=2)
+
+
+def centre_distance_pairs(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance between the centres of boxes a[i] and b[i]."""
+    return np.linalg.norm(centres(a) - centres(b), axis=1)
 
 
 def gospa(a: np.ndarray, b: np.ndarray, c: float, p: float) -> float:
@@ -147,6 +154,7 @@ class EpisodeMetrics:
         # per frame, for the global passes: dense ids, similarity, and the boxes (for GOSPA)
         # per frame, for the global passes: dense GT and tracker ids, similarity, boxes (for GOSPA)
         self._frames: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self._matches: list[tuple[int, np.ndarray, np.ndarray]] = []  # CLEAR matches: frame, GT rows, track rows
 
     # ------------------------------------------------------------ per frame
 
@@ -193,6 +201,7 @@ class EpisodeMetrics:
         prev[self._prev_rows] = -1
         prev[mg] = mt
         self._prev_rows = mg
+        self._matches.append((len(self._frames) - 1, rows, cols))
         tp, s = len(mg), float(sim[rows, cols].sum())
         fn, fp = len(g) - tp, len(t) - tp
         self.tp, self.fp, self.fn, self.idsw = self.tp + tp, self.fp + fp, self.fn + fn, self.idsw + idsw
@@ -225,6 +234,10 @@ class EpisodeMetrics:
             "Frag": int(np.maximum(frag[frag > 0] - 1, 0).sum()),
             "MT": mt, "PT": pt, "ML": num_gt_ids - mt - pt,
         }
+        errors = np.concatenate([centre_distance_pairs(self._frames[f][3][r], self._frames[f][4][c])
+                                 for f, r, c in self._matches] or [np.zeros(0)])
+        out["CentreError"] = float(errors.mean()) if len(errors) else 0.0
+        out["CentreErrorVar"] = float(errors.var()) if len(errors) else 0.0
         out.update(self._identity(flat))
         out.update(_hota(flat, self._frames))
         out["GOSPA"] = float(np.mean([self.frame_gospa(i) for i in range(len(self._frames))])) if self._frames else 0.0

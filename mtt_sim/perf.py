@@ -1,4 +1,4 @@
-"""`mtt-sim perf`: env step and metrics throughput, each with a reference measured in the same run.
+"""`mtt-sim perf`: env, metrics and JPDA throughput, each with a reference measured in the same run.
 
 Env reference: the least any frame-producing step must do, copying a background of the same size
 and drawing the same N filled ellipses with OpenCV. Metrics reference: the least a CLEAR update
@@ -13,6 +13,8 @@ import time
 import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
+
+import trackers
 
 from .env import TrackingEnv
 from .metrics import EpisodeMetrics, box_iou
@@ -121,4 +123,41 @@ def report_metrics(rows: list[dict]) -> str:
            "|---:|---:|---:|---:|---:|---:|"]
     out += [f"| {r['objects']} | {r['frames']} | {r['update_us']:.0f} us | {r['reference_us']:.0f} us | "
             f"{r['update_over_reference']:.2f}x | {r['summary_s'] * 1e3:.1f} ms |" for r in rows]
+    return "\n".join(out)
+
+
+def _recorded_detections(n: int, frames: int) -> list[dict]:
+    """Observations of `n` targets with P_D = 0.9 and Poisson clutter 5 per frame, recorded once."""
+    env = TrackingEnv("clutter_storm", config={"groups.0.count": n, "sensor.pd": 0.9, "sensor.clutter_rate": 5.0,
+                                               "sensor.min_visibility": 0.0, "env.max_steps": frames},
+                      obs_mode="detections")
+    obs, _ = env.reset(seed=0)
+    out = []
+    for _ in range(frames):
+        out.append({k: v.copy() if hasattr(v, "copy") else v for k, v in obs.items()})
+        obs = env.step({"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))})[0]
+    return out
+
+
+def _ms_per_frame(spec: str, observations: list[dict]) -> float:
+    tracker = trackers.make(spec)
+    tracker.reset({})
+    return _time(lambda: [tracker.update(o) for o in observations]) / len(observations) * 1e3
+
+
+def measure_jpda(repeats: int = 5, frames: int = 150) -> list[dict]:
+    """Medians of jpda's milliseconds per frame (tracker time only) at 10, 20 and 50 targets, against gnn."""
+    rows = []
+    for n in (10, 20, 50):
+        obs = _recorded_detections(n, frames)
+        runs = [(_ms_per_frame("jpda", obs), _ms_per_frame("gnn", obs)) for _ in range(repeats)]
+        jpda, gnn = (statistics.median(r[i] for r in runs) for i in range(2))
+        rows.append({"targets": n, "jpda_ms": jpda, "gnn_ms": gnn, "jpda_over_gnn": jpda / gnn})
+    return rows
+
+
+def report_jpda(rows: list[dict]) -> str:
+    out = ["jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
+           "| targets | jpda ms/frame | gnn ms/frame | jpda / gnn |", "|---:|---:|---:|---:|"]
+    out += [f"| {r['targets']} | {r['jpda_ms']:.2f} | {r['gnn_ms']:.2f} | {r['jpda_over_gnn']:.2f}x |" for r in rows]
     return "\n".join(out)

@@ -87,7 +87,7 @@ def test_bad_inputs():
 # ------------------------------------------------------------------ motion situations and the tracker
 
 import trackers  # noqa: E402
-from trackers.jpda import NEW, NORMAL, OCCLUDED, REVIVED, SPLIT, VANISHED, situations  # noqa: E402
+from trackers.jpda import NEW, NORMAL, OCCLUDED, REVIVED, SEPARATED, SPLIT, VANISHED, situations  # noqa: E402
 
 
 def test_situations_from_beta_prime():
@@ -177,26 +177,34 @@ def crossing_paths():
              lambda k: b(k) if k not in merged else None], a, b)
 
 
-@pytest.mark.parametrize("velocity, kept", [("keep", True), ("zero", False)])
-def test_occlusion_merge_then_separation(velocity, kept):
+def test_occlusion_merge_then_separation_keeps_ids():
     paths, a, b = crossing_paths()
-    t = trackers.make("jpda", occlusion_velocity=velocity)
+    t = trackers.make("jpda")
     t.reset({})
     owner = {}
     for k, obs in enumerate(frames(paths, 20)):
         tracks = t.update(obs)
         if k == 9:
             assert t.last["situations"] == [OCCLUDED, OCCLUDED]
+        if k == 12:
+            assert t.last["situations"] == [SEPARATED, SEPARATED]  # one measurement each as they come apart
         centres = tracks.boxes[:, :2] + tracks.boxes[:, 2:] / 2
         if k not in range(9, 12):
             for tid, c in zip(tracks.ids.tolist(), centres):
                 who = "a" if np.hypot(*(c - a(k))) < np.hypot(*(c - b(k))) else "b"  # the nearer target
                 owner.setdefault(tid, set()).add(who)
-    # with each target's own velocity kept through the merge, both come out on their own side with their ids;
-    # with the paper's zero velocity they share one state and do not
-    assert (owner == {1: {"a"}, 2: {"b"}}) == kept, owner
+    # each target keeps its own velocity through the merge, so both come out on their own side with their ids
+    assert owner == {1: {"a"}, 2: {"b"}}, owner
 
 
 def test_bad_occlusion_velocity():
     with pytest.raises(ValueError, match="occlusion_velocity='stop': allowed: 'keep', 'zero'"):
         trackers.make("jpda:occlusion_velocity=stop")
+
+
+def test_a_duplicate_sharing_one_blob_for_long_is_dropped():
+    """Two targets that sit in one blob for merge_frames frames are one object: the younger goes."""
+    a = lambda k: (20 + 2 * k, 50) if k < 3 else (20 + 2 * k, 54)  # noqa: E731
+    b = lambda k: (20 + 2 * k, 58) if k < 3 else None  # noqa: E731  (merged into a's blob from frame 3 on)
+    t, out = run([a, b], 30, meas_sigma=6.0, merge_frames=10)
+    assert out[5][1] == [OCCLUDED, OCCLUDED] and len(t.ids) == 1 and out[-1][0] == [1]

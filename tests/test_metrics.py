@@ -59,6 +59,9 @@ def test_one_pixel_off():
     assert s["LocA"] == pytest.approx((16 * iou + 3 * 1.0) / 19)
     assert s["HOTA"] == pytest.approx(16 / 19)
     assert s["GOSPA"] == pytest.approx(1.0)
+    assert (s["CentreError"], s["CentreErrorVar"]) == (1.0, 0.0)
+    s = evaluate([frame(A)] * 2, [frame((1, 1, 0, 10, 10)), frame((1, 3, 0, 10, 10))])
+    assert s["CentreError"] == pytest.approx(2.0) and s["CentreErrorVar"] == pytest.approx(1.0)
 
 
 def test_previous_frame_not_last_ever_match_gets_the_bonus():

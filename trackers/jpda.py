@@ -74,7 +74,9 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
     n, m = w.shape
     if k is not None and (not isinstance(k, (int, np.integer)) or k < 1):
         raise ValueError(f"k must be None (exact) or a positive integer, got {k!r}")
-    events = _all_events(w, miss) if k is None else _best_events(w, miss, int(k))
+    # one target's joint events are its m + 1 options: with k >= m + 1 the k best are all of them
+    everything = k is None or (n == 1 and k >= m + 1)
+    events = _all_events(w, miss) if everything else _best_events(w, miss, int(k))
     total = sum(weight for _, weight in events)
     if not total > 0:
         raise ValueError("no joint event has a nonzero probability (pd = 1 and a target without a gated measurement?)")
@@ -88,6 +90,7 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
 # ------------------------------------------------------------------ the tracker
 
 NORMAL, NEW, VANISHED, OCCLUDED, SPLIT, REVIVED = "normal", "new", "vanished", "occluded", "split", "revived"
+SEPARATED = "separated"
 
 
 def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -136,7 +139,8 @@ class Jpda(Tracker):
     occluded targets jump to the shared measurement with zero velocity; a target vanished for vanish_frames frames is
     ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
-    last size. Reported: targets that had a measurement this frame. situations=false drops the occlusion
+    last size. Reported: targets that had a measurement this frame (and min_hits frames in a row; 1 in the paper,
+    which reports every new target at once). situations=false drops the occlusion
     correction and the revival (plain JPDA with births and deaths); occlusion_velocity=zero follows the paper's
     text (see the comment in update); k=0 means the paper's K."""
 
@@ -144,7 +148,8 @@ class Jpda(Tracker):
     description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
     defaults = {"pd": 0.9, "clutter_density": 1e-5, "gate_probability": 0.99, "k": 0, "vanish_frames": 3,
                 "revive_frames": 5, "accel_sigma": 0.5, "meas_sigma": 4.0, "min_confidence": 0.0,
-                "situations": True, "occlusion_velocity": "keep"}
+                "situations": True, "occlusion_velocity": "keep", "speed_sigma0": 2.0, "min_hits": 1,
+                "merge_frames": 40}
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -154,14 +159,17 @@ class Jpda(Tracker):
 
     def reset(self, info=None):
         p = self.params
-        self.model = point_model(p["accel_sigma"], p["meas_sigma"])
+        self.model = point_model(p["accel_sigma"], p["meas_sigma"], p["speed_sigma0"])
         self.kf = KalmanBank(self.model)
-        self.ids, self.misses, self.sizes = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 2))
+        self.ids, self.misses, self.hits = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.age, self.together = np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.sizes = np.zeros((0, 2))
         self.ended = {"ids": np.zeros(0, np.int64), "age": np.zeros(0, np.int64), "sizes": np.zeros((0, 2)),
                       "bank": KalmanBank(self.model)}
         self.next_id = 1
         self.gate = chi2_gate(2, p["gate_probability"])
-        self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool), "gates": []}
+        self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool),
+                     "ids": np.zeros(0, np.int64), "centres": np.zeros((0, 2)), "S": np.zeros((0, 2, 2))}
 
     # -------------------------------------------------------------- one frame
 
@@ -173,9 +181,12 @@ class Jpda(Tracker):
         self.kf.predict()
         self.ended["bank"].predict()
         self.ended["age"] += 1
-        beta, gated = self._associate(z)
+        beta, gated, g = self._associate(z)
         situ, unexplained = situations(beta[:, 1:].T)
-        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "gates": self._gate_shapes()}
+        if p["situations"]:
+            self._separate(situ, beta, g)
+        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": self.ids.copy(),
+                     "centres": self.kf.measurement(), "S": self.kf.innovation_covariance()}
         self._jpda_update(beta, z)
         best = np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int)
         for t, s in enumerate(situ):
@@ -185,15 +196,22 @@ class Jpda(Tracker):
                 # come out on their own sides ("zero" is the paper's text, kept for the ablation).
                 velocity = self.kf.x[t, 2:] if p["occlusion_velocity"] == "keep" else np.zeros(2)
                 self.kf.x[t] = np.r_[z[best[t]], velocity]
-                self.kf.P[t, :2, :2] = self.model.P0[:2, :2]
-            if s == NORMAL:
+                self.kf.P[t, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
+                self.kf.P[t, :2, 2:] = self.kf.P[t, 2:, :2] = 0.0
+            if s in (NORMAL, SEPARATED):
                 self.sizes[t] = dets[best[t], 2:4]
         self.misses = np.where(np.array([s == VANISHED for s in situ], bool), self.misses + 1, 0)
+        own = np.array([s in (NORMAL, SEPARATED, SPLIT) for s in situ], bool)  # a miss says nothing either way
+        self.together = np.where(own, 0, self.together + np.array([s == OCCLUDED for s in situ], bool))
+        self.age += 1
+        if p["situations"]:
+            self._drop_duplicates(situ, best)
         self._end_vanished()
         fresh = self._revive(z, dets, unexplained) if p["situations"] else unexplained
         self._add(z[fresh], dets[fresh, 2:4])
         self.last["situations"] += [REVIVED] * (len(self.ids) - len(situ) - len(fresh)) + [NEW] * len(fresh)
-        seen = self.misses == 0
+        self.hits = np.where(self.misses == 0, self.hits + 1, 0)
+        seen = (self.misses == 0) & (self.hits >= p["min_hits"])
         centre = self.kf.x[seen, :2]
         return Tracks.of(self.ids[seen], np.c_[centre - self.sizes[seen] / 2, self.sizes[seen]])
 
@@ -203,7 +221,7 @@ class Jpda(Tracker):
         beta = np.zeros((n, m + 1))
         beta[:, 0] = 1.0
         if not n or not m:
-            return beta, np.zeros((n, m), bool)
+            return beta, np.zeros((n, m), bool), np.zeros((n, m))
         d2 = self.kf.mahalanobis(z)
         gated = d2 <= self.gate
         det_s = np.linalg.det(self.kf.innovation_covariance())
@@ -214,7 +232,22 @@ class Jpda(Tracker):
             b = association_probabilities(g[np.ix_(ti, zj)], p["pd"], p["clutter_density"], self._k(len(ti), len(zj)))
             beta[ti, 0] = b[:, 0]
             beta[np.ix_(ti, zj + 1)] = b[:, 1:]
-        return beta, gated
+        return beta, gated, g
+
+    def _separate(self, situ: list[str], beta: np.ndarray, g: np.ndarray) -> None:
+        """Targets that shared a blob last frame and now see several measurements take one each, from the most
+        probable joint event, instead of the soft JPDA mixture that would hold them together at the blob (the
+        paper's split rule is meant for fragments of one target; it does not say how merged targets come apart)."""
+        rows = np.flatnonzero((self.together > 0) & np.array([s == SPLIT for s in situ], bool))
+        if len(rows) < 2:
+            return
+        cols = np.flatnonzero(beta[rows, 1:].sum(axis=0) > 0)
+        w, miss = _factors(g[np.ix_(rows, cols)], self.params["pd"], self.params["clutter_density"])
+        chosen = np.asarray(_best_events(w, miss, 1)[0][0])
+        beta[rows] = 0.0
+        beta[rows, np.where(chosen >= 0, cols[chosen] + 1, 0)] = 1.0
+        for t in rows:
+            situ[t] = SEPARATED
 
     def _k(self, n_targets: int, n_measurements: int) -> int | None:
         """How many joint events a cluster uses: the paper's K = targets + measurements unless set."""
@@ -232,7 +265,27 @@ class Jpda(Tracker):
         combined = np.einsum("nm,nmi->ni", b, nu)
         spread = np.einsum("nm,nmi,nmj->nij", b, nu, nu) - combined[:, :, None] * combined[:, None, :]
         self.kf.x = x + np.einsum("nij,nj->ni", K, combined)
-        self.kf.P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
+        P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
+        self.kf.P = (P + P.transpose(0, 2, 1)) / 2  # keep it symmetric against rounding
+
+    def _drop_duplicates(self, situ: list[str], best: np.ndarray) -> None:
+        """Targets occluded together with an older one are dropped when they are younger than vanish_frames (a
+        fragment or a clutter blob beside it) or have shared its blob for merge_frames frames (one object): the
+        paper's occlusion rule would keep such duplicates at the same place for ever."""
+        occluded = np.flatnonzero(np.array([s == OCCLUDED for s in situ], bool))
+        if len(occluded) < 2:
+            return
+        blob = best[occluded]
+        order = np.lexsort((self.ids[occluded], -self.age[occluded], blob))  # by blob, then oldest, then lowest id
+        first = np.r_[True, blob[order][1:] != blob[order][:-1]]
+        keeper = np.zeros(len(occluded), bool)
+        keeper[order[first]] = True  # the elder of each blob stays
+        p = self.params
+        duplicate = (self.age[occluded] < p["vanish_frames"]) | (self.together[occluded] >= p["merge_frames"])
+        dropped = duplicate & ~keeper
+        keep = np.ones(len(self.ids), bool)
+        keep[occluded[dropped]] = False
+        self._keep(keep)
 
     def _end_vanished(self) -> None:
         """Targets vanished for vanish_frames frames leave the active set for the revival pool."""
@@ -261,6 +314,9 @@ class Jpda(Tracker):
             e["bank"].update(rows, z[unexplained[cols]])
             self.ids = np.r_[self.ids, e["ids"][rows]]
             self.misses = np.r_[self.misses, np.zeros(len(rows), np.int64)]
+            self.hits = np.r_[self.hits, np.zeros(len(rows), np.int64)]
+            self.age = np.r_[self.age, np.full(len(rows), self.params["vanish_frames"], np.int64)]
+            self.together = np.r_[self.together, np.zeros(len(rows), np.int64)]
             self.sizes = np.r_[self.sizes, dets[unexplained[cols], 2:4]]
             self.kf.x, self.kf.P = np.r_[self.kf.x, e["bank"].x[rows]], np.r_[self.kf.P, e["bank"].P[rows]]
             keep = np.ones(len(e["ids"]), bool)
@@ -276,31 +332,28 @@ class Jpda(Tracker):
         self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + len(z))]
         self.next_id += len(z)
         self.misses = np.r_[self.misses, np.zeros(len(z), np.int64)]
+        self.hits = np.r_[self.hits, np.zeros(len(z), np.int64)]
+        self.age = np.r_[self.age, np.zeros(len(z), np.int64)]
+        self.together = np.r_[self.together, np.zeros(len(z), np.int64)]
         self.sizes = np.r_[self.sizes, sizes]
 
     def _keep(self, mask: np.ndarray) -> None:
         self.kf.keep(mask)
-        self.ids, self.misses, self.sizes = self.ids[mask], self.misses[mask], self.sizes[mask]
-
-    def _gate_shapes(self) -> list[dict]:
-        """Gate ellipses d^2 = gate around each target's predicted centre, with its id."""
-        out = []
-        if not len(self.ids):
-            return out
-        for tid, centre, S in zip(self.ids.tolist(), self.kf.measurement(), self.kf.innovation_covariance()):
-            val, vec = np.linalg.eigh(S)
-            out.append({"kind": "ellipse", "center": centre, "axes": np.sqrt(self.gate * val[::-1]),
-                        "angle": float(np.degrees(np.arctan2(vec[1, 1], vec[0, 1]))), "color": (0, 200, 255),
-                        "id": tid})
-        return out
+        self.ids, self.misses, self.hits = self.ids[mask], self.misses[mask], self.hits[mask]
+        self.age, self.together, self.sizes = self.age[mask], self.together[mask], self.sizes[mask]
 
     def debug(self) -> list[dict]:
-        """Gate ellipses, each target's motion situation as text, and the validation matrix and beta as data."""
-        out = list(self.last["gates"])
-        for gate, situation in zip(self.last["gates"], self.last["situations"]):
-            out.append({"kind": "text", "xy": gate["center"] + np.array([6.0, -6.0]), "text": situation,
+        """The last association's gate ellipses (d^2 = gate around each predicted centre), each target's motion
+        situation as text, and the validation matrix and beta as data."""
+        out = []
+        last = self.last
+        for centre, S, situation in zip(last["centres"], last["S"], last["situations"]):
+            val, vec = np.linalg.eigh(S)
+            out.append({"kind": "ellipse", "center": centre, "axes": np.sqrt(self.gate * val[::-1]),
+                        "angle": float(np.degrees(np.arctan2(vec[1, 1], vec[0, 1]))), "color": (0, 200, 255)})
+            out.append({"kind": "text", "xy": centre + np.array([6.0, -6.0]), "text": situation,
                         "color": (255, 255, 255)})
-        out.append({"kind": "data", "validation": self.last["gated"], "beta": self.last["beta"]})
+        out.append({"kind": "data", "ids": last["ids"], "validation": last["gated"], "beta": last["beta"]})
         return out
 
 
