@@ -141,7 +141,8 @@ class Jpda(Tracker):
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
     last size. Reported: targets that had a measurement this frame (and min_hits frames in a row; 1 in the paper,
     which reports every new target at once). situations=false drops the occlusion
-    correction, the separation and the revival (plain JPDA with births and deaths); occlusion_velocity=keep keeps
+    correction, the separation, the duplicate rule and the revival (plain JPDA with births and deaths);
+    occlusion_velocity=keep keeps
     each occluded target's velocity (the paper zeroes it); k=0 means the paper's K. Deviations from the paper,
     each a gap it leaves open: merged targets coming apart take one measurement each from the best joint event;
     duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped."""
