@@ -71,6 +71,18 @@ def test_k_best_converges_to_exact_and_equals_it_with_every_event(problem):
     assert errors[-1] <= errors[0] + 1e-12
 
 
+@settings(max_examples=150, deadline=None)
+@given(problems(), st.integers(1, 12))
+def test_murty_finds_the_k_heaviest_joint_events(problem, k):
+    """The enumeration shortcut for small clusters and Murty agree on which events are the k best."""
+    from trackers.jpda import _best_events
+    w, miss = _factors(*problem)
+    heaviest = sorted((weight for _, weight in _all_events(w, miss)), reverse=True)[:k]
+    found = [weight for _, weight in _best_events(w, miss, k)]
+    scale = heaviest[0] if heaviest else 1.0
+    np.testing.assert_allclose(np.array(found) * scale, heaviest, rtol=1e-9)  # Murty's weights are relative
+
+
 def test_bad_inputs():
     with pytest.raises(ValueError, match="non-negative"):
         association_probabilities(np.array([[-1.0]]), 0.9, 1.0)

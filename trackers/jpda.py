@@ -20,6 +20,9 @@ from .base import Tracker, Tracks, detections, register
 from .kalman import KalmanBank, point_model
 
 
+ENUMERATE_UP_TO = 256  # clusters with at most this many joint events (an upper bound) are enumerated
+
+
 def _factors(g, pd, clutter_density) -> tuple[np.ndarray, np.ndarray]:
     """Per-pair detection factors P_D g / lambda (n, m) and per-target miss factors 1 - P_D (n,), validated."""
     g = np.asarray(g, float)
@@ -74,9 +77,15 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
     n, m = w.shape
     if k is not None and (not isinstance(k, (int, np.integer)) or k < 1):
         raise ValueError(f"k must be None (exact) or a positive integer, got {k!r}")
-    # one target's joint events are its m + 1 options: with k >= m + 1 the k best are all of them
-    everything = k is None or (n == 1 and k >= m + 1)
-    events = _all_events(w, miss) if everything else _best_events(w, miss, int(k))
+    # Few joint events (bounded by the product of each target's options): enumerating them all and keeping the k
+    # heaviest gives the same k best events as Murty, far cheaper than its subproblems. Otherwise Murty.
+    few = np.prod(1.0 + (w > 0).sum(axis=1)) <= ENUMERATE_UP_TO
+    if k is None:
+        events = _all_events(w, miss)
+    elif few:
+        events = sorted(_all_events(w, miss), key=lambda e: -e[1])[: int(k)]
+    else:
+        events = _best_events(w, miss, int(k))
     total = sum(weight for _, weight in events)
     if not total > 0:
         raise ValueError("no joint event has a nonzero probability (pd = 1 and a target without a gated measurement?)")
@@ -140,10 +149,9 @@ class Jpda(Tracker):
     ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
     last size. Reported: targets that had a measurement this frame (and min_hits frames in a row; 1 in the paper,
-    which reports every new target at once). situations=false drops the occlusion
-    correction, the separation, the duplicate rule and the revival (plain JPDA with births and deaths);
-    occlusion_velocity=keep keeps
-    each occluded target's velocity (the paper zeroes it); k=0 means the paper's K. Deviations from the paper,
+    which reports every new target at once). situations=false drops the occlusion correction, the separation,
+    the duplicate rule and the revival (plain JPDA with births and deaths); occlusion_velocity=keep keeps each
+    occluded target's velocity (the paper zeroes it); k=0 means the paper's K. Deviations from the paper,
     each a gap it leaves open: merged targets coming apart take one measurement each from the best joint event;
     duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped."""
 
@@ -230,7 +238,12 @@ class Jpda(Tracker):
         det_s = np.linalg.det(self.kf.innovation_covariance())
         g = np.where(gated, np.exp(-0.5 * d2) / (2 * np.pi * np.sqrt(det_s))[:, None], 0.0)
         t_label, z_label = clusters(gated)
-        for c in np.unique(t_label[gated.any(axis=1)]):
+        has = gated.any(axis=1)
+        alone = has & (np.bincount(t_label)[t_label] == 1)  # a target alone in its cluster: its m + 1 events in closed form
+        w = p["pd"] * g[alone] / p["clutter_density"]
+        total = (1 - p["pd"]) + w.sum(axis=1, keepdims=True)
+        beta[alone, 0], beta[alone, 1:] = (1 - p["pd"]) / total[:, 0], w / total
+        for c in np.unique(t_label[has & ~alone]):
             ti, zj = np.flatnonzero(t_label == c), np.flatnonzero(z_label == c)
             b = association_probabilities(g[np.ix_(ti, zj)], p["pd"], p["clutter_density"], self._k(len(ti), len(zj)))
             beta[ti, 0] = b[:, 0]
