@@ -1,4 +1,4 @@
-"""The `mtt-sim` command: list scenarios, run an episode, measure speed, print the config reference."""
+"""The `mtt-sim` command: list scenarios, run an episode, bench and sweep trackers, measure speed, print the config."""
 
 from __future__ import annotations
 

@@ -53,9 +53,10 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
             break
     if writer:
         writer.close()
-    frames = env.metrics.summary()["num_frames"]
+    metrics = env.metrics.summary()
+    frames = metrics["num_frames"]
     return {"tracker": tracker, "params": agent.params, "scenario": str(scenario), "seed": seed,
-            "config": dict(config or {}), "metrics": env.metrics.summary(),
+            "config": dict(config or {}), "metrics": metrics,
             "tracker_fps": frames / max(tracker_time, 1e-9), "env_fps": frames / max(env_time, 1e-9)}
 
 
