@@ -9,7 +9,7 @@ import tomllib
 
 from . import experiment, perf, scenario
 
-SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "TP", "FP", "FN", "IDSW", "Frag",
+SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW", "Frag",
                 "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
 
 
@@ -97,6 +97,8 @@ def cmd_perf(args) -> int:
     print(perf.report_metrics(perf.measure_metrics(repeats=args.repeats)))
     print()
     print(perf.report_jpda(perf.measure_jpda(repeats=args.repeats)))
+    print()
+    print(perf.report_pf(perf.measure_pf(repeats=args.repeats)))
     return 0
 
 

@@ -28,14 +28,25 @@ def hs_bins(frame: np.ndarray, h_levels: int = 8, s_levels: int = 8) -> np.ndarr
 
 
 def _region_pixels(centres: np.ndarray, size: tuple[int, int], shape: tuple[int, int]):
-    """Row and column of every pixel of every region (n, h, w), and which of them lie inside the image."""
+    """Flat image index of every pixel of every w x h region (n, h, w), and whether it lies inside the image."""
     w, h = size
-    x0 = np.round(centres[:, 0] - w / 2).astype(int)
-    y0 = np.round(centres[:, 1] - h / 2).astype(int)
-    rows = y0[:, None, None] + np.arange(h)[None, :, None]
-    cols = x0[:, None, None] + np.arange(w)[None, None, :]
-    inside = (rows >= 0) & (rows < shape[0]) & (cols >= 0) & (cols < shape[1])
-    return np.clip(rows, 0, shape[0] - 1), np.clip(cols, 0, shape[1] - 1), inside
+    x0 = np.round(centres[:, 0] - w / 2).astype(np.intp)
+    y0 = np.round(centres[:, 1] - h / 2).astype(np.intp)
+    rows = y0[:, None, None] + np.arange(h)[None, :, None]  # (n, h, 1)
+    cols = x0[:, None, None] + np.arange(w)[None, None, :]  # (n, 1, w)
+    inside = ((rows >= 0) & (rows < shape[0])) & ((cols >= 0) & (cols < shape[1]))
+    flat = np.clip(rows, 0, shape[0] - 1) * shape[1] + np.clip(cols, 0, shape[1] - 1)
+    return flat, inside
+
+
+def _binned(per_pixel_bin: np.ndarray, n_bins: int, flat: np.ndarray, inside: np.ndarray,
+            weights: np.ndarray | None) -> np.ndarray:
+    """Histograms (n, n_bins): region pixels outside the image go to a sentinel bin that is dropped."""
+    n = len(flat)
+    b = np.where(inside, per_pixel_bin, n_bins)
+    index = (np.arange(n)[:, None, None] * (n_bins + 1) + b).ravel()
+    w = None if weights is None else np.broadcast_to(weights, b.shape).ravel()
+    return np.bincount(index, weights=w, minlength=n * (n_bins + 1)).reshape(n, n_bins + 1)[:, :n_bins]
 
 
 def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[int, int],
@@ -44,18 +55,18 @@ def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[i
 
     `weights` (h, w) weighs each region pixel (a kernel); regions wholly outside the image give zeros.
     """
-    rows, cols, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, bins.shape)
-    n = len(rows)
-    pixel_weight = inside * (1.0 if weights is None else weights[None])
-    index = np.arange(n)[:, None, None] * n_bins + bins[rows, cols]
-    hist = np.bincount(index.ravel(), weights=pixel_weight.ravel(), minlength=n * n_bins).reshape(n, n_bins)
-    total = hist.sum(axis=1, keepdims=True)
-    return hist / np.where(total > 0, total, 1.0)
+    flat, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, bins.shape)
+    hist = _binned(bins.ravel().take(flat), n_bins, flat, inside, weights)
+    total = (inside * (1.0 if weights is None else weights[None])).sum(axis=(1, 2))
+    return hist / np.where(total > 0, total, 1.0)[:, None]
 
 
 def bhattacharyya(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of seed 001)."""
-    return np.sqrt(np.asarray(p) * np.asarray(q)[None]).sum(axis=1)
+    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of seed 001);
+    only q's nonzero bins can contribute, so only they are read."""
+    q = np.asarray(q)
+    nz = np.flatnonzero(q)
+    return np.sqrt(np.asarray(p)[:, nz] * q[nz][None]).sum(axis=1)
 
 
 def orientation_maps(frame: np.ndarray, n_orient: int = 8) -> tuple[np.ndarray, np.ndarray]:
@@ -76,14 +87,12 @@ def gradient_descriptors(orient: np.ndarray, magnitude: np.ndarray, centres: np.
     cell's orientation bin; vectors are L2-normalised so distances compare across regions and contrasts.
     """
     w, h = size
-    rows, cols, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, orient.shape)
-    n = len(rows)
+    flat, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, orient.shape)
     yy, xx = np.mgrid[0:h, 0:w]
     cell = (yy * cells // h) * cells + (xx * cells // w)  # (h, w) cell of each region pixel
     gauss = np.exp(-(((xx - (w - 1) / 2) ** 2) + ((yy - (h - 1) / 2) ** 2)) / (2 * (w / 2) ** 2))
     n_bins = cells * cells * n_orient
-    index = np.arange(n)[:, None, None] * n_bins + cell[None] * n_orient + orient[rows, cols]
-    weight = inside * gauss[None] * magnitude[rows, cols]
-    vec = np.bincount(index.ravel(), weights=weight.ravel(), minlength=n * n_bins).reshape(n, n_bins)
+    weight = gauss[None] * magnitude.ravel().take(flat)
+    vec = _binned(cell[None] * n_orient + orient.ravel().take(flat), n_bins, flat, inside, weight)
     norm = np.linalg.norm(vec, axis=1, keepdims=True)
     return vec / np.where(norm > 0, norm, 1.0)
