@@ -34,3 +34,20 @@ def placed(sc: scenario.Scenario, positions, seed=0) -> TrackingEnv:
     env.world.place(np.asarray(positions, float))
     env.observe()
     return env
+
+
+def run_tracker(spec, env_id, config=None, seed=0, obs_mode="detections"):
+    """One episode of tracker `spec` on `env_id` through gym.make: (the episode's metrics, the tracker)."""
+    import gymnasium as gym
+
+    import mtt_sim  # noqa: F401  (registers the env ids)
+    import trackers
+
+    env = gym.make(env_id, obs_mode=obs_mode, config=config or {})
+    obs, info = env.reset(seed=seed)
+    tracker = trackers.make(spec)
+    tracker.reset(info)
+    while True:
+        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
+        if term or trunc:
+            return info["metrics"], tracker

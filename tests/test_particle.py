@@ -6,18 +6,12 @@ import pytest
 
 import mtt_sim  # noqa: F401  (registers the env ids)
 import trackers
+from helpers import run_tracker
 from trackers.particle import systematic_resample
 
 
-def episode(spec, steps=200, seed=0, **make):
-    env = gym.make("mtt_sim/Umbrellas-v0", config={"env.max_steps": steps}, **make)
-    obs, info = env.reset(seed=seed)
-    tracker = trackers.make(spec)
-    tracker.reset(info)
-    while True:
-        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
-        if term or trunc:
-            return info["metrics"], tracker
+def episode(spec, steps=200, seed=0):
+    return run_tracker(spec, "mtt_sim/Umbrellas-v0", {"env.max_steps": steps}, seed, obs_mode="frame+detections")
 
 
 def test_fusion_holds_the_target_where_colour_alone_jumps_to_the_alike_umbrella():

@@ -1,12 +1,17 @@
 """Tracker agents: a hand-made detection sequence with known tracks, the easy-scene sanity bar, the interface."""
 
+from itertools import permutations
+
 import gymnasium as gym
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-import mtt_sim
+import mtt_sim  # noqa: F401
 import trackers
-from trackers.assignment import assign, iou_matrix
+from helpers import run_tracker
+from trackers.assignment import assign, iou_matrix, murty
 from trackers.kalman import KalmanBank, box_model, boxes_to_z, point_model, z_to_boxes
 
 BASELINES = ["sort", "iou", "gnn", "bytetrack"]
@@ -64,14 +69,7 @@ EASY = {"sensor": {"pd": 0.99, "clutter_rate": 0.0, "merge_prob": 0.0, "fragment
 
 
 def run_episode(spec, env_id, config, seed=0):
-    env = gym.make(env_id, obs_mode="detections", config=config)
-    obs, info = env.reset(seed=seed)
-    tracker = trackers.make(spec)
-    tracker.reset(info)
-    while True:
-        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
-        if term or trunc:
-            return info["metrics"]
+    return run_tracker(spec, env_id, config, seed)[0]
 
 
 @pytest.mark.parametrize("name", BASELINES)
@@ -174,13 +172,6 @@ def test_trackers_never_import_the_simulator():
 
 
 # ------------------------------------------------------------------ Murty's k-best assignments
-
-from itertools import permutations  # noqa: E402
-
-from hypothesis import given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from trackers.assignment import murty  # noqa: E402
 
 
 @st.composite

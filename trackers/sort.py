@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from .assignment import assign, iou_matrix
 from .base import Tracker, Tracks, detections, register
 from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
