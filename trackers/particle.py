@@ -17,6 +17,16 @@ def frame_of(obs) -> np.ndarray:
     return np.asarray(frame)
 
 
+def crop_around(frame: np.ndarray, centres: np.ndarray, size) -> tuple[np.ndarray, np.ndarray]:
+    """(origin, crop): the part of the frame holding every w x h region centred at `centres` (n, 2), with a
+    2-pixel margin for gradients; features of the whole frame would cost far more than those of these pixels."""
+    half = np.asarray(size) / 2 + 2
+    h, w = frame.shape[:2]
+    x0, y0 = np.clip(np.floor(centres.min(axis=0) - half).astype(int), 0, (w - 1, h - 1))
+    x1, y1 = np.clip(np.ceil(centres.max(axis=0) + half).astype(int) + 1, (x0 + 1, y0 + 1), (w, h))
+    return np.array([x0, y0], float), np.ascontiguousarray(frame[y0:y1, x0:x1])
+
+
 def systematic_resample(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Indices of a systematic resample of each row of `weights` (targets, particles), rows summing to one."""
     k, n = weights.shape
@@ -56,14 +66,9 @@ class ColourTextureParticleFilter(Tracker):
         self.templates: list[tuple[np.ndarray, np.ndarray]] = []
 
     def _maps(self, frame: np.ndarray, centres: np.ndarray, size: np.ndarray):
-        """Bin and gradient maps of the part of the frame that holds every region of one target (origin, maps):
-        features of the whole frame would cost far more than those of the pixels its particles look at."""
-        half = np.asarray(size) / 2 + 2
-        h, w = frame.shape[:2]
-        x0, y0 = np.clip(np.floor(centres.min(axis=0) - half).astype(int), 0, (w - 1, h - 1))
-        x1, y1 = np.clip(np.ceil(centres.max(axis=0) + half).astype(int) + 1, (x0 + 1, y0 + 1), (w, h))
-        crop = np.ascontiguousarray(frame[y0:y1, x0:x1])
-        return np.array([x0, y0], float), (rgb_bins(crop, self.params["levels"]), *orientation_maps(crop))
+        """Bin and gradient maps of the crop that holds every region of one target: (origin, maps)."""
+        origin, crop = crop_around(frame, centres, size)
+        return origin, (rgb_bins(crop, self.params["levels"]), *orientation_maps(crop))
 
     def _features(self, maps, centres: np.ndarray, size) -> tuple[np.ndarray, np.ndarray]:
         bins, orient, magnitude = maps
