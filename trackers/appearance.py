@@ -27,13 +27,14 @@ def hs_bins(frame: np.ndarray, h_levels: int = 8, s_levels: int = 8) -> np.ndarr
     return h * s_levels + s
 
 
-def _region_pixels(centres: np.ndarray, size: tuple[int, int], shape: tuple[int, int]):
-    """Flat image index of every pixel of every w x h region (n, h, w), and whether it lies inside the image."""
+def _region_pixels(centres: np.ndarray, size: tuple[int, int], shape: tuple[int, int], stride: int = 1):
+    """Flat image index of every `stride`-th pixel (rows and columns) of every w x h region (n, h', w'), and
+    whether it lies inside the image."""
     w, h = size
     x0 = np.round(centres[:, 0] - w / 2).astype(np.intp)
     y0 = np.round(centres[:, 1] - h / 2).astype(np.intp)
-    rows = y0[:, None, None] + np.arange(h)[None, :, None]  # (n, h, 1)
-    cols = x0[:, None, None] + np.arange(w)[None, None, :]  # (n, 1, w)
+    rows = y0[:, None, None] + np.arange(0, h, stride)[None, :, None]  # (n, h', 1)
+    cols = x0[:, None, None] + np.arange(0, w, stride)[None, None, :]  # (n, 1, w')
     inside = ((rows >= 0) & (rows < shape[0])) & ((cols >= 0) & (cols < shape[1]))
     flat = np.clip(rows, 0, shape[0] - 1) * shape[1] + np.clip(cols, 0, shape[1] - 1)
     return flat, inside
@@ -50,12 +51,13 @@ def _binned(per_pixel_bin: np.ndarray, n_bins: int, flat: np.ndarray, inside: np
 
 
 def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[int, int],
-               weights: np.ndarray | None = None) -> np.ndarray:
+               weights: np.ndarray | None = None, stride: int = 1) -> np.ndarray:
     """Normalised histograms (n, n_bins) of `bins` over the w x h regions centred at `centres` (n, 2).
 
-    `weights` (h, w) weighs each region pixel (a kernel); regions wholly outside the image give zeros.
+    `weights` (sampled rows, sampled columns) weighs each region pixel (a kernel); `stride` samples every
+    stride-th row and column (a regular sample of a large region); regions wholly outside the image give zeros.
     """
-    flat, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, bins.shape)
+    flat, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, bins.shape, stride)
     hist = _binned(bins.ravel().take(flat), n_bins, flat, inside, weights)
     total = (inside * (1.0 if weights is None else weights[None])).sum(axis=(1, 2))
     return hist / np.where(total > 0, total, 1.0)[:, None]

@@ -32,12 +32,14 @@ class InteractiveParticleFilter(Tracker):
     another target by more than lambda = 0.75 of the smaller region form the conflict set (eq. 2); such a particle
     is visible if its own template scores best among all targets' templates, and otherwise is weighted with the
     best template's likelihood divided by its distance to the target's previous estimate (eq. 4). The state is the
-    weighted mean (eq. 5). interactive=false weighs every particle with its own template (independent filters)."""
+    weighted mean (eq. 5). interactive=false weighs every particle with its own template (independent filters).
+    Histograms use a regular sample of about `samples` pixels of each region (every pixel with samples=0, as in
+    the paper): 4 books x 100 particles x 80 x 110 pixels would otherwise be 3.5 million pixels a frame."""
 
     name = "ipf"
     description = "Seed 002: interactive particle filter through full occlusion (Liu et al. 2011; hand-initialised)"
     defaults = {"particles": 100, "conflict_ratio": 0.75, "sigma2": 0.045, "h_levels": 16, "s_levels": 16,
-                "interactive": True, "seed": 0}
+                "interactive": True, "samples": 256, "seed": 0}
     needs_frame = True
 
     def reset(self, info=None):
@@ -55,7 +57,8 @@ class InteractiveParticleFilter(Tracker):
         p = self.params
         origin, crop = crop_around(frame, centres, size)
         bins = hs_bins(crop, p["h_levels"], p["s_levels"])
-        return histograms(bins, p["h_levels"] * p["s_levels"], centres - origin, tuple(size))
+        stride = max(1, int(np.sqrt(np.prod(size) / p["samples"]))) if p["samples"] else 1
+        return histograms(bins, p["h_levels"] * p["s_levels"], centres - origin, tuple(size), stride=stride)
 
     def _likelihood(self, hist: np.ndarray, template: np.ndarray) -> np.ndarray:
         """Eq. 6-7: a Gaussian in the Bhattacharyya distance."""
