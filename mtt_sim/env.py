@@ -168,8 +168,7 @@ class TrackingEnv(gym.Env):
         w = self.world
         self.frame, self.labels = frame, labels
         self.truth: Truth = measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group],
-                                    self.renderer.occluder_boxes - np.r_[self.renderer.camera.offset, 0, 0],
-                                    self.renderer.occluder_depth)
+                                    self.renderer.occluder_image_boxes(), self.renderer.occluder_depth)
         self.detections: Detections = self.sensor.detect(self.truth, labels, frame)
         rows = self.detections.rows
         padded = np.zeros((sc.sensor.max_detections, 5), np.float32)

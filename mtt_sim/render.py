@@ -94,6 +94,7 @@ class Renderer:
         self.occluder_boxes = np.array([o.rect for o in occ], float).reshape(-1, 4)
         self.occluder_depth = (self.occluder_boxes[:, 1] + self.occluder_boxes[:, 3]) if sc.world.projection == "standing" \
             else np.full(len(occ), np.inf)
+        self.occluder_is_rect = np.array([o.shape == "rect" for o in occ], bool)
 
     def _background(self) -> np.ndarray:
         """The static world backdrop, with a margin for a shaking camera."""
@@ -123,6 +124,10 @@ class Renderer:
         boxes[:, :2] -= self.camera.offset
         return boxes
 
+    def occluder_image_boxes(self) -> np.ndarray:
+        """Every occluder's box in image pixels."""
+        return self.occluder_boxes - np.r_[self.camera.offset, 0, 0]
+
     def render(self, world: World, draw_frame: bool = True, show_targets: bool = True):
         """(frame or None, labels, image boxes) for the world's current state."""
         h, w = self.shape
@@ -132,8 +137,7 @@ class Renderer:
         frame = self.canvas[off[1] + m: off[1] + m + h, off[0] + m: off[0] + m + w].copy() if draw_frame else None
         boxes = self.image_boxes(world)
         n = len(boxes) if show_targets else 0
-        occ_boxes = self.occluder_boxes - np.r_[off, 0, 0]
-        all_boxes = np.concatenate([boxes[:n], occ_boxes])
+        all_boxes = np.concatenate([boxes[:n], self.occluder_image_boxes()])
         onscreen = (all_boxes[:, 0] < w) & (all_boxes[:, 1] < h) & (all_boxes[:, 0] + all_boxes[:, 2] > 0) & \
                    (all_boxes[:, 1] + all_boxes[:, 3] > 0)
         order = np.argsort(np.concatenate([world.depth()[:n], self.occluder_depth]), kind="stable")
@@ -141,7 +145,7 @@ class Renderer:
         texture = world.texture_of_group[world.group]
         colors = world.color.tolist()
         geometry = fixed_point(all_boxes)
-        rect = np.concatenate([is_rect[:n], [o.shape == "rect" for o in self.sc.occluders]]).astype(bool).tolist()
+        rect = np.concatenate([is_rect[:n], self.occluder_is_rect]).tolist()
         for i in order[onscreen[order]].tolist():
             if i < n:
                 draw_fixed(labels, geometry, i, rect[i], i + 1)

@@ -6,7 +6,7 @@ import numpy as np
 
 from .appearance import bhattacharyya, histograms, hs_bins
 from .base import Tracker, Tracks, register
-from .particle import crop_around, frame_of
+from .particle import crop_around, frame_of, initial_targets
 
 
 def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.ndarray:
@@ -43,11 +43,7 @@ class InteractiveParticleFilter(Tracker):
     needs_frame = True
 
     def reset(self, info=None):
-        info = info or {}
-        boxes = np.asarray(info.get("init_boxes", np.zeros((0, 4))), float).reshape(-1, 4)
-        self.ids = np.asarray(info.get("init_ids", []), np.int64)
-        self.sizes = np.maximum(np.round(boxes[:, 2:]), 4).astype(int)
-        self.estimates = boxes[:, :2] + boxes[:, 2:] / 2
+        self.ids, self.estimates, self.sizes = initial_targets(info)
         self.sigma = np.sqrt(np.prod(self.sizes, axis=1)) / 2
         self.rng = np.random.default_rng(self.params["seed"])
         self.templates = None

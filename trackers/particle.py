@@ -17,6 +17,14 @@ def frame_of(obs) -> np.ndarray:
     return np.asarray(frame)
 
 
+def initial_targets(info) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ids, centres (k, 2), integer sizes (k, 2), at least 4 px) of the boxes env.reset gives hand-initialised trackers."""
+    info = info or {}
+    boxes = np.asarray(info.get("init_boxes", np.zeros((0, 4))), float).reshape(-1, 4)
+    sizes = np.maximum(np.round(boxes[:, 2:]), 4).astype(int)
+    return np.asarray(info.get("init_ids", []), np.int64), boxes[:, :2] + boxes[:, 2:] / 2, sizes
+
+
 def crop_around(frame: np.ndarray, centres: np.ndarray, size) -> tuple[np.ndarray, np.ndarray]:
     """(origin, crop): the part of the frame holding every w x h region centred at `centres` (n, 2), with a
     2-pixel margin for gradients; features of the whole frame would cost far more than those of these pixels."""
@@ -55,12 +63,7 @@ class ColourTextureParticleFilter(Tracker):
     needs_frame = True
 
     def reset(self, info=None):
-        info = info or {}
-        self.ids = np.asarray(info.get("init_ids", []), np.int64)
-        self.sizes = np.round(np.asarray(info.get("init_boxes", np.zeros((0, 4))), float).reshape(-1, 4)[:, 2:]).astype(int)
-        self.sizes = np.maximum(self.sizes, 4)
-        boxes = np.asarray(info.get("init_boxes", np.zeros((0, 4))), float).reshape(-1, 4)
-        self.start = boxes[:, :2] + boxes[:, 2:] / 2
+        self.ids, self.start, self.sizes = initial_targets(info)
         self.rng = np.random.default_rng(self.params["seed"])
         self.particles = None  # (targets, N, 4), made at the first frame
         self.templates: list[tuple[np.ndarray, np.ndarray]] = []
