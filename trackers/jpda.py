@@ -125,17 +125,10 @@ def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
     first = np.argmax(positive, axis=0) if len(positive) else np.zeros(positive.shape[1], int)
     only = np.where(per_col == 1, first, -1)  # a target's single measurement
     sharing = np.bincount(only[only >= 0], minlength=len(beta_prime))
-    out = []
-    for t in range(beta_prime.shape[1]):
-        if per_col[t] == 0:
-            out.append(VANISHED)
-        elif per_col[t] > 1:
-            out.append(SPLIT)
-        elif sharing[only[t]] > 1:
-            out.append(OCCLUDED)
-        else:
-            out.append(NORMAL)  # its one measurement may be shared with targets that have others: plain JPDA
-    return out, np.flatnonzero(per_row == 0)
+    shared = np.where(only >= 0, sharing[np.maximum(only, 0)] if len(sharing) else 0, 0) > 1
+    # NORMAL includes a single measurement shared with targets that have others too: plain JPDA
+    kind = np.select([per_col == 0, per_col > 1, shared], [VANISHED, SPLIT, OCCLUDED], NORMAL)
+    return kind.tolist(), np.flatnonzero(per_row == 0)
 
 
 @register
@@ -200,20 +193,22 @@ class Jpda(Tracker):
                      "centres": self.kf.measurement(), "S": self.kf.innovation_covariance()}
         self._jpda_update(beta, z)
         best = np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int)
-        for t, s in enumerate(situ):
-            if s == OCCLUDED and p["situations"]:  # the merged blob's centre (section 5, 4)
-                # The paper also zeroes the velocity, so merged targets share one state and _separate's best joint
-                # event decides who leaves the blob as whom; occlusion_velocity=keep lets each keep its own
-                # velocity instead (over 10 seeds of crossing and soccer the two do not differ significantly).
-                velocity = self.kf.x[t, 2:] if p["occlusion_velocity"] == "keep" else np.zeros(2)
-                self.kf.x[t] = np.r_[z[best[t]], velocity]
-                self.kf.P[t, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
-                self.kf.P[t, :2, 2:] = self.kf.P[t, 2:, :2] = 0.0
-            if s in (NORMAL, SEPARATED):
-                self.sizes[t] = dets[best[t], 2:4]
-        self.misses = np.where(np.array([s == VANISHED for s in situ], bool), self.misses + 1, 0)
-        own = np.array([s in (NORMAL, SEPARATED, SPLIT) for s in situ], bool)  # a miss says nothing either way
-        self.together = np.where(own, 0, self.together + np.array([s == OCCLUDED for s in situ], bool))
+        kind = np.array(situ, dtype=object)
+        occluded = np.flatnonzero(kind == OCCLUDED) if p["situations"] else np.zeros(0, int)
+        # The merged blob's centre (section 5, 4). The paper also zeroes the velocity, so merged targets share one
+        # state and _separate's best joint event decides who leaves the blob as whom; occlusion_velocity=keep lets
+        # each keep its own velocity instead (over 10 seeds of crossing and soccer the two do not differ
+        # significantly).
+        self.kf.x[occluded, :2] = z[best[occluded]]
+        if p["occlusion_velocity"] == "zero":
+            self.kf.x[occluded, 2:] = 0.0
+        self.kf.P[occluded, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
+        self.kf.P[occluded, :2, 2:] = self.kf.P[occluded, 2:, :2] = 0.0
+        sized = np.flatnonzero((kind == NORMAL) | (kind == SEPARATED))
+        self.sizes[sized] = dets[best[sized], 2:4]
+        self.misses = np.where(kind == VANISHED, self.misses + 1, 0)
+        own = (kind == NORMAL) | (kind == SEPARATED) | (kind == SPLIT)  # a miss says nothing either way
+        self.together = np.where(own, 0, self.together + (kind == OCCLUDED))
         self.age += 1
         if p["situations"]:
             self._drop_duplicates(situ, best)
@@ -254,7 +249,7 @@ class Jpda(Tracker):
         """Targets that shared a blob last frame and now see several measurements take one each, from the most
         probable joint event, instead of the soft JPDA mixture that would hold them together at the blob (the
         paper's split rule is meant for fragments of one target; it does not say how merged targets come apart)."""
-        rows = np.flatnonzero((self.together > 0) & np.array([s == SPLIT for s in situ], bool))
+        rows = np.flatnonzero((self.together > 0) & (np.array(situ, dtype=object) == SPLIT))
         if len(rows) < 2:
             return
         cols = np.flatnonzero(beta[rows, 1:].sum(axis=0) > 0)
@@ -288,7 +283,7 @@ class Jpda(Tracker):
         """Targets occluded together with an older one are dropped when they are younger than vanish_frames (a
         fragment or a clutter blob beside it) or have shared its blob for merge_frames frames (one object): the
         paper's occlusion rule would keep such duplicates at the same place for ever."""
-        occluded = np.flatnonzero(np.array([s == OCCLUDED for s in situ], bool))
+        occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
         if len(occluded) < 2:
             return
         blob = best[occluded]
