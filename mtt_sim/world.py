@@ -53,7 +53,8 @@ class World:
         self._buf = pbatch.Buffer()
         n_cols = {"ids": np.int64, "group": np.intp, "pos": (np.float64, 2), "vel": (np.float64, 2),
                   "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
-                  "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64}
+                  "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64,
+                  "carry_offset": (np.float64, 2)}
         self._cols = list(n_cols)
         for name, spec_ in n_cols.items():
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
@@ -177,7 +178,8 @@ class World:
         row = dict(ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
                    cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
                    goal=self._pick_goal(pos), stopped=False, born=self.t,
-                   carrier_id=0 if carrier is None else int(self.ids[carrier]))
+                   carrier_id=0 if carrier is None else int(self.ids[carrier]),
+                   carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier])
         for name in self._cols:
             setattr(self, name, np.concatenate([getattr(self, name), np.asarray(row[name])[None].astype(getattr(self, name).dtype)]))
         self.next_id += 1
@@ -195,16 +197,12 @@ class World:
             shape = pymunk.Circle(body, 0.5 * min(size))
         shape.elasticity, shape.friction = self._elasticity, 0.0
         bit = 1 << g.layer
-        if carrier is not None:  # it rides on its carrier and touches nothing else
+        if carrier is not None:  # it rides on its carrier (pinned after each step) and touches nothing
             mask = 0
         else:
             mask = WALL_BIT | (0 if self.sc.world.collision == "none" else bit)
         shape.filter = pymunk.ShapeFilter(categories=bit, mask=mask)
         self.space.add(body, shape)
-        if carrier is not None:
-            joint = pymunk.PivotJoint(self.bodies[carrier], body, tuple(pos))
-            joint.collide_bodies = False
-            self.space.add(joint)
         return body
 
     def _pick_goal(self, pos: np.ndarray) -> np.ndarray:
@@ -260,7 +258,7 @@ class World:
             scale = self.depth_scale(self.pos[:, 1])[:, None]
             self.vel = body_vel / scale
             self._apply_motion()
-            out = self._carry(self.vel * scale, body_vel)
+            out = self._carry(self.vel * scale)
             vel = data[:, 2:].copy()  # rows that are not targets (the static body) keep their own velocity
             vel[self._rows] = out[self._row_slot]
             buf = pbatch.Buffer()
@@ -270,19 +268,31 @@ class World:
         self.t += 1
         if len(self.ids):
             self.pos = self._slot_view(self._read_bodies())[:, :2]
+            self._pin_carried()
         self._remove(self._leaving())
         self._spawn_births()
 
-    def _carry(self, out: np.ndarray, body_vel: np.ndarray) -> np.ndarray:
-        """Carried targets move with their carrier's new velocity (chipmunk integrates positions before it solves
-        joints, so the pivot joint alone would lag one frame); a carried target whose carrier died drifts on."""
+    def _carried(self) -> tuple[np.ndarray, np.ndarray]:
+        """(slots of carried targets whose carrier is alive, their carriers' slots)."""
         carried = np.flatnonzero(self.carrier_id)
-        if len(carried):
-            slot = np.searchsorted(self.ids, self.carrier_id[carried]).clip(0, len(self.ids) - 1)
-            alive = self.ids[slot] == self.carrier_id[carried]
-            out[carried] = np.where(alive[:, None], out[slot], body_vel[carried])
-            self.vel[carried] = np.where(alive[:, None], self.vel[slot], self.vel[carried])
+        slot = np.searchsorted(self.ids, self.carrier_id[carried]).clip(0, max(len(self.ids) - 1, 0))
+        alive = self.ids[slot] == self.carrier_id[carried] if len(carried) else np.zeros(0, bool)
+        return carried[alive], slot[alive]
+
+    def _carry(self, out: np.ndarray) -> np.ndarray:
+        """Carried targets move with their carrier's new velocity; one whose carrier died drifts on."""
+        carried, slot = self._carried()
+        out[carried] = out[slot]
+        self.vel[carried] = self.vel[slot]
         return out
+
+    def _pin_carried(self):
+        """Put each carried target back at its offset from its carrier: walls and contacts change the carrier's
+        velocity inside the physics step, which the carried body (touching nothing) would not follow."""
+        carried, slot = self._carried()
+        self.pos[carried] = self.pos[slot] + self.carry_offset[carried]
+        for i in carried.tolist():
+            self.bodies[i].position = tuple(self.pos[i])
 
     def _apply_motion(self):
         """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""
