@@ -58,7 +58,9 @@ def _grid_output(args, records, tables):
 def cmd_bench(args) -> int:
     records = experiment.run_grid(args.trackers.split(","), args.scenarios.split(","), args.seeds,
                                   config=parse_overrides(args.config), workers=args.workers, progress=True)
-    _grid_output(args, records, [experiment.markdown(experiment.summarize(records, m)) for m in args.metric.split(",")])
+    title = args.scenarios if args.by == "target" else ""
+    _grid_output(args, records, [experiment.markdown(experiment.summarize(records, m, by=args.by), title)
+                                 for m in args.metric.split(",")])
     return 0
 
 
@@ -128,6 +130,9 @@ def build_parser() -> argparse.ArgumentParser:
         g = sub.add_parser(name, help=text)
         if name == "bench":
             g.add_argument("--scenarios", required=True, help="comma-separated scenario keys")
+            g.add_argument("--by", choices=("scenario", "target"), default="scenario",
+                           help="columns: scenarios, or ground-truth ids for the per-target metrics CentreError and "
+                                "Coverage (hand-initialised trackers; one scenario)")
         else:
             g.add_argument("scenario")
             g.add_argument("--param", required=True, metavar="KEY=V1,V2,...", help="e.g. sensor.clutter_rate=0,2,5,10,20")

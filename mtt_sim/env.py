@@ -109,6 +109,8 @@ class TrackingEnv(gym.Env):
                                             np.random.SeedSequence(self.np_random.integers(2**63)).spawn(3))
         self.world = World(sc, world_rng)
         self.renderer = Renderer(sc, render_rng)
+        if sc.render.camera == "follow":
+            self.renderer.camera.follow(self.world)
         empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
         self.sensor = make_sensor(sc, sensor_rng, empty)
         s = sc.scoring
@@ -141,7 +143,7 @@ class TrackingEnv(gym.Env):
         stats = self.metrics.update(self.truth.ids[scored], self.truth.boxes[scored], ids, boxes)
         reward = self._reward(stats)
         self.world.step()
-        self.renderer.camera.advance()
+        self.renderer.camera.advance(self.world)
         self.steps += 1
         obs = self.observe()
         terminated = bool(self.world.finished)

@@ -56,7 +56,7 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
     metrics = env.metrics.summary()
     frames = metrics["num_frames"]
     return {"tracker": tracker, "params": agent.params, "scenario": str(scenario), "seed": seed,
-            "config": dict(config or {}), "metrics": metrics,
+            "config": dict(config or {}), "metrics": metrics, "per_target": env.metrics.per_target(),
             "tracker_fps": frames / max(tracker_time, 1e-9), "env_fps": frames / max(env_time, 1e-9)}
 
 
@@ -117,16 +117,26 @@ def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float]
 
 
 def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario") -> list[dict]:
-    """One row per (tracker, `by`) cell: the metric's mean and 95 % interval over seeds, and the speeds."""
-    cells: dict[tuple, list[dict]] = {}
+    """One row per (tracker, `by`) cell: the metric's mean and 95 % interval over seeds, and the speeds. `by` is
+    "scenario", "config" (sweeps) or "target" (a per-target metric, CentreError or Coverage, per GT id)."""
+    cells: dict[tuple, list[tuple[float, dict]]] = {}
     for r in records:
-        key = (r["tracker"], r["scenario"] if by == "scenario" else json.dumps(r["config"], sort_keys=True))
-        cells.setdefault(key, []).append(r)
+        if by == "target":
+            per = r["per_target"]
+            if per and metric not in next(iter(per.values())):
+                raise ValueError(f"unknown per-target metric {metric!r}; available: {', '.join(next(iter(per.values())))}")
+            for gid, values in sorted(per.items(), key=lambda kv: int(kv[0])):
+                cells.setdefault((r["tracker"], f"target {gid}"), []).append((values[metric], r))
+            continue
+        if metric not in r["metrics"]:
+            raise ValueError(f"unknown metric {metric!r}; available: {', '.join(r['metrics'])}")
+        column = r["scenario"] if by == "scenario" else json.dumps(r["config"], sort_keys=True)
+        cells.setdefault((r["tracker"], column), []).append((r["metrics"][metric], r))
     rows = []
-    for (tracker, column), rs in cells.items():
-        if metric not in rs[0]["metrics"]:
-            raise ValueError(f"unknown metric {metric!r}; available: {', '.join(rs[0]['metrics'])}")
-        mean, ci = mean_ci([r["metrics"][metric] for r in rs])
+    for (tracker, column), cell in cells.items():
+        values = np.array([v for v, _ in cell], float)
+        mean, ci = mean_ci(values[np.isfinite(values)])
+        rs = [r for _, r in cell]
         rows.append({"tracker": tracker, "column": column, "metric": metric, "mean": mean, "ci95": ci, "n": len(rs),
                      "tracker_fps": float(np.median([r["tracker_fps"] for r in rs])),
                      "env_fps": float(np.median([r["env_fps"] for r in rs]))})

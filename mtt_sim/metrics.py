@@ -151,7 +151,6 @@ class EpisodeMetrics:
         self._prev_rows = np.zeros(0, np.intp)  # GT indices whose `_prev` is set
         self.tp = self.fp = self.fn = self.idsw = 0
         self.similarity_total = 0.0
-        # per frame, for the global passes: dense ids, similarity, and the boxes (for GOSPA)
         # per frame, for the global passes: dense GT and tracker ids, similarity, boxes (for GOSPA)
         self._frames: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._matches: list[tuple[int, np.ndarray, np.ndarray]] = []  # CLEAR matches: frame, GT rows, track rows
@@ -234,8 +233,7 @@ class EpisodeMetrics:
             "Frag": int(np.maximum(frag[frag > 0] - 1, 0).sum()),
             "MT": mt, "PT": pt, "ML": num_gt_ids - mt - pt,
         }
-        errors = np.concatenate([centre_distance_pairs(self._frames[f][3][r], self._frames[f][4][c])
-                                 for f, r, c in self._matches] or [np.zeros(0)])
+        _, errors = self._match_distances()
         out["CentreError"] = float(errors.mean()) if len(errors) else 0.0
         out["CentreErrorVar"] = float(errors.var()) if len(errors) else 0.0
         out.update(self._identity(flat))
@@ -244,6 +242,24 @@ class EpisodeMetrics:
         out.update(num_frames=len(self._frames), num_gt_dets=flat.num_gt_dets, num_gt_ids=num_gt_ids,
                    num_tracker_dets=flat.num_trk_dets, num_tracker_ids=num_trk_ids)
         return {k: (float(v) if isinstance(v, (float, np.floating)) else int(v)) for k, v in out.items()}
+
+    def _match_distances(self) -> tuple[np.ndarray, np.ndarray]:
+        """(dense GT index, centre distance) of every CLEAR match so far."""
+        pairs = [(self._frames[f][0][r], centre_distance_pairs(self._frames[f][3][r], self._frames[f][4][c]))
+                 for f, r, c in self._matches]
+        return tuple(np.concatenate(x) for x in zip(*pairs)) if pairs else (np.zeros(0, np.intp), np.zeros(0))
+
+    def per_target(self) -> dict[int, dict]:
+        """Per GT id: Coverage (the fraction of its frames with a CLEAR match) and CentreError (the mean centre
+        distance of those matches, nan if none): the per-target tracking error the papers plot."""
+        n = len(self._gt_ids)
+        gt, dist = self._match_distances()
+        total = np.bincount(gt, dist, minlength=n)
+        matched, seen = self._matched.ensure(n)[:n], self._seen.ensure(n)[:n]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            error, coverage = total / matched, matched / np.maximum(seen, 1)
+        return {int(i): {"Coverage": float(coverage[k]), "CentreError": float(error[k])}
+                for i, k in self._gt_ids.index.items()}
 
     def _identity(self, flat: "_Flat") -> dict:
         """IDTP = the largest number of frames a one-to-one GT-to-tracker id assignment can match."""

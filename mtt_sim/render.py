@@ -49,15 +49,17 @@ def draw_blob(img: np.ndarray, box, is_rect: bool, value) -> None:
 
 
 class Camera:
-    """Where the image window sits in the world: static, panning back and forth, or shaking by hand."""
+    """Where the image window sits in the world: static, panning back and forth, following the targets, or shaking
+    by hand."""
 
     def __init__(self, sc: Scenario, rng: np.random.Generator):
         r = sc.render
         self.mode, self.rng = r.camera, rng
-        self.span = np.array(sc.world_size) - (r.width, r.height)
+        self.image_size = np.array([r.width, r.height], float)
+        self.span = np.array(sc.world_size) - self.image_size
         self.velocity = np.array(r.pan_speed, float)
         self.sigma = r.shake
-        self.base = self.span / 2 if self.mode != "pan" else np.zeros(2)
+        self.base = self.span / 2 if self.mode not in ("pan", "follow") else np.zeros(2)
         self.jitter = np.zeros(2)
         self.margin = int(math.ceil(4 * self.sigma)) if self.mode == "shake" else 0
 
@@ -66,8 +68,18 @@ class Camera:
         """World coordinates of the image's top-left pixel (integer: the background is cropped, not resampled)."""
         return np.round(self.base + self.jitter)
 
-    def advance(self):
-        if self.mode == "pan":
+    def follow(self, world: World, max_step: np.ndarray | float = np.inf):
+        """Move toward centring the targets' mean in the image, at most `max_step` per axis (a following camera
+        jumps there at reset)."""
+        if len(world.ids):
+            boxes = world.boxes()
+            wanted = (boxes[:, :2] + boxes[:, 2:] / 2).mean(axis=0) - self.image_size / 2
+            self.base = np.clip(self.base + np.clip(wanted - self.base, -max_step, max_step), 0, self.span)
+
+    def advance(self, world: World):
+        if self.mode == "follow":
+            self.follow(world, np.abs(self.velocity))
+        elif self.mode == "pan":
             nxt = self.base + self.velocity
             bounce = (nxt < 0) | (nxt > self.span)
             self.velocity = np.where(bounce, -self.velocity, self.velocity)

@@ -122,8 +122,10 @@ class RenderConfig:
     flicker: float = spec(0.0, "standard deviation of a per-frame relative gain jitter", "", 0.0, 0.5)
     noise: float = spec(0.0, "Gaussian pixel noise standard deviation", "grey levels", 0.0, 100.0)
     blur: float = spec(0.0, "Gaussian blur sigma (0 = none)", "px", 0.0, 20.0)
-    camera: str = spec("static", "static; pan: sweeps across a larger world; shake: handheld jitter", choices=("static", "pan", "shake"))
-    pan_speed: tuple[float, float] = spec((2.0, 0.0), "pan: camera velocity, reversing at the world's edges", "px/frame", -100.0, 100.0)
+    camera: str = spec("static", "static; pan: sweeps across a larger world; follow: keeps the targets' mean centred; "
+                       "shake: handheld jitter", choices=("static", "pan", "follow", "shake"))
+    pan_speed: tuple[float, float] = spec((2.0, 0.0), "pan: camera velocity, reversing at the world's edges; follow: its "
+                                          "largest speed", "px/frame", -100.0, 100.0)
     shake: float = spec(3.0, "shake: standard deviation of the camera offset", "px", 0.0, 100.0)
 
 
@@ -338,8 +340,9 @@ def _check_references(sc: Scenario, where: str) -> Scenario:
     if ww < sc.render.width or wh < sc.render.height:
         raise ConfigError(f"{where}: world.size = {sc.world.size}: must be at least the image size "
                           f"({sc.render.width}, {sc.render.height}) or 0")
-    if sc.sensor.model == "foreground" and sc.render.camera == "pan":
-        raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = 'pan'")
+    if sc.sensor.model == "foreground" and sc.render.camera in ("pan", "follow"):
+        raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = "
+                          f"{sc.render.camera!r}")
     return sc
 
 

@@ -315,7 +315,9 @@ class World:
         self.vel = vel
 
     def _manoeuvre(self, vel: np.ndarray, mask: np.ndarray) -> np.ndarray:
-        """Sudden turns by 60..180 degrees, stops and restarts for the manoeuvring targets in `mask`."""
+        """Sudden turns by 60..180 degrees, stops and restarts for the manoeuvring targets in `mask`; between them a
+        target's speed returns toward its cruising speed (10 % a frame), so a bounce off a wall does not slow it for
+        good."""
         turn_p, stop_p = self._param["turn_prob"][self.group], self._param["stop_prob"][self.group]
         u = self.rng.random((3, len(vel)))
         angle = np.radians(self.rng.uniform(60, 180, len(vel))) * np.where(u[2] < 0.5, -1, 1)
@@ -323,6 +325,8 @@ class World:
         c, s = np.cos(angle), np.sin(angle)
         turned = np.stack([c * vel[:, 0] - s * vel[:, 1], s * vel[:, 0] + c * vel[:, 1]], axis=1)
         vel = np.where(turn[:, None], turned, vel)
+        speed = np.maximum(np.hypot(*vel.T), 1e-9)
+        vel = np.where(mask[:, None], vel * (1 + 0.1 * (self.cruise / speed - 1))[:, None], vel)
         restart = mask & self.stopped & (u[1] < 5 * stop_p)
         stop = mask & ~self.stopped & (u[1] < stop_p)
         heading = self.rng.uniform(0, 2 * math.pi, len(vel))

@@ -198,5 +198,7 @@ def test_gospa_and_iou_rewards():
 
 
 def test_min_visibility_drops_hidden_targets_from_scoring():
-    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5, "scoring.min_visibility": 0.5})
-    assert all(f["num_gt"] < 4 for f in frames)  # the book under the top book is not scored
+    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5, "scoring.min_visibility": 0.8})
+    assert all(f["num_gt"] < 4 for f in frames)  # the large book, 72 % visible under the top book, is not scored
+    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5})
+    assert all(f["num_gt"] == 4 for f in frames)

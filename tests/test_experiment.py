@@ -43,3 +43,14 @@ def test_summarize_and_markdown():
     assert "| a | 0.600 ± " in table and "| b | 0.100 ± 0.000 | 100 | 1 |" in table
     with pytest.raises(ValueError, match="unknown metric 'MOTX'"):
         experiment.summarize(records, "MOTX")
+
+
+def test_summarize_by_target_averages_each_ground_truth_id_over_seeds():
+    records = [{"tracker": "a", "scenario": "x", "config": {}, "metrics": {}, "tracker_fps": 1.0, "env_fps": 1.0,
+                "per_target": {1: {"CentreError": e1, "Coverage": 1.0}, 2: {"CentreError": e2, "Coverage": c2}}}
+               for e1, e2, c2 in [(1.0, 4.0, 0.5), (3.0, math.nan, 0.0)]]
+    rows = experiment.summarize(records, "CentreError", by="target")
+    assert [(r["column"], r["mean"]) for r in rows] == [("target 1", 2.0), ("target 2", 4.0)]  # never matched: no error
+    assert [r["mean"] for r in experiment.summarize(records, "Coverage", by="target")] == [1.0, 0.25]
+    with pytest.raises(ValueError, match="unknown per-target metric 'MOTA'; available: CentreError, Coverage"):
+        experiment.summarize(records, "MOTA", by="target")

@@ -64,6 +64,18 @@ def test_one_pixel_off():
     assert s["CentreError"] == pytest.approx(2.0) and s["CentreErrorVar"] == pytest.approx(1.0)
 
 
+def test_per_target_centre_error_and_coverage():
+    m = EpisodeMetrics()
+    for f in range(4):  # target 1 matched 1 px off in all 4 frames; target 2 matched 3 px off in frames 0 and 1 only
+        tracks = [(5, 1, 0, 10, 10)] + ([(6, 103, 0, 10, 10)] if f < 2 else [])
+        m.update(*frame(A, B), *frame(*tracks))
+    m.update(*frame((3, 50, 50, 10, 10)), *E)  # target 3: never matched
+    per = m.per_target()
+    assert per[1] == {"Coverage": 1.0, "CentreError": 1.0} and per[2] == {"Coverage": 0.5, "CentreError": 3.0}
+    assert per[3]["Coverage"] == 0.0 and math.isnan(per[3]["CentreError"])
+    assert m.summary()["CentreError"] == pytest.approx((4 * 1 + 2 * 3) / 6)
+
+
 def test_previous_frame_not_last_ever_match_gets_the_bonus():
     # frame 1 misses A (a false track elsewhere keeps the frame from being skipped), so in frame 2 the
     # previous-timestep carry-over is empty: the better-overlapping new id 2 wins and that is a switch.

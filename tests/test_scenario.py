@@ -24,7 +24,7 @@ def test_unknown_scenario_lists_the_available_ones():
     ({"sensor.pd": 1.5}, r"sensor\.pd = 1\.5: out of range; allowed: 0\.0 <= value <= 1\.0"),
     ({"sensor.bogus": 1}, r"unknown key sensor\.bogus; allowed keys: model, preset, pd"),
     ({"render.width": "wide"}, r"render\.width = 'wide': expected an integer"),
-    ({"render.camera": "drone"}, r"render\.camera = 'drone': allowed values: 'static', 'pan', 'shake'"),
+    ({"render.camera": "drone"}, r"render\.camera = 'drone': allowed values: 'static', 'pan', 'follow', 'shake'"),
     ({"world.walls": 1}, r"world\.walls = 1: expected true or false"),
     ({"groups.0.color": [1, 2]}, r"groups\.0\.color = \[1, 2\]: expected 3 values"),
     ({"groups.0.speed": float("nan")}, r"groups\.0\.speed = nan: expected a finite number"),
@@ -38,10 +38,11 @@ def test_bad_values_name_the_file_the_key_and_what_is_allowed(overrides, pattern
 
 
 def test_cross_field_rules():
-    with pytest.raises(ConfigError, match=r"groups\.1\.carrier = 'nobody': must name another group"):
-        load("books", {"groups.1.carrier": "nobody"})
-    with pytest.raises(ConfigError, match=r"foreground' needs a static or shaking camera"):
-        load("crossing", {"render.camera": "pan"})
+    with pytest.raises(ConfigError, match=r"groups\.2\.carrier = 'nobody': must name another group"):
+        load("books", {"groups.2.carrier": "nobody"})
+    for camera in ("pan", "follow"):
+        with pytest.raises(ConfigError, match=r"foreground' needs a static or shaking camera"):
+            load("crossing", {"render.camera": camera})
     with pytest.raises(ConfigError, match=r"world\.size .* must be at least the image size"):
         load("crossing", {"world.size": [100.0, 100.0]})
 

@@ -62,17 +62,21 @@ def test_umbrellas_same_colour_different_texture_on_a_shaking_camera():
     assert any((t.visibility < 0.9).any() for t, *_ in rec)          # the trunk hides an umbrella
 
 
-def test_books_one_carried_book_hides_another():
-    env, rec = run("books", 50)
-    assert all(len(t) == 4 for t, *_ in rec)
-    assert all((t.visibility < 0.3).sum() >= 1 for t, *_ in rec)    # the carrier lies under the top book
-    assert env.world.shape_is_rect.all()
+def test_books_the_large_book_hides_a_small_one_completely_and_carries_the_top_one():
+    env, rec = run("books", 400)
+    vis = np.array([t.visibility for t, *_ in rec])                  # (frames, 4): ids 1, 2 small, 3 large, 4 top
+    assert vis.shape == (400, 4) and env.world.shape_is_rect.all()
+    assert (vis[:, :2] < 0.01).sum() >= 10                           # full occlusions of a small book
+    assert np.allclose(vis[:, 2], 1 - 60 * 80 / (130 * 170), atol=0.02) and (vis[:, 3] == 1).all()
 
 
-def test_skating_camera_pans_and_motion_is_fast():
-    env, rec = run("skating", 60)
+def test_skating_camera_follows_fast_skaters():
+    env, rec = run("skating", 500)
     offsets = np.array([o for *_, o in rec])
-    assert offsets[-1, 0] - offsets[0, 0] == pytest.approx(2.5 * 59, abs=1)
+    assert np.ptp(offsets[:, 0]) > 10 and np.abs(np.diff(offsets[:, 0])).max() <= 6   # pans, at most 6 px a frame
+    centres = np.array([(t.boxes[:, 0] + t.boxes[:, 2] / 2).mean() for t, *_ in rec])
+    inside = (offsets[:, 0] > 0) & (offsets[:, 0] < 640 - 320)       # away from the rink's ends the camera keeps up
+    assert inside.sum() > 20 and np.median(np.abs(centres[inside] - 160)) < 10
     assert np.hypot(*env.world.vel.T).max() > 3
 
 

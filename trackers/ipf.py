@@ -56,11 +56,17 @@ class InteractiveParticleFilter(Tracker):
         stride = max(1, int(np.sqrt(np.prod(size) / p["samples"]))) if p["samples"] else 1
         return histograms(bins, p["h_levels"] * p["s_levels"], centres - origin, tuple(size), stride=stride)
 
-    def _likelihood(self, hist: np.ndarray, template: np.ndarray) -> np.ndarray:
-        """Eq. 6-7: a Gaussian in the Bhattacharyya distance."""
-        s2 = self.params["sigma2"]
-        d2 = np.clip(1.0 - bhattacharyya(hist, template), 0.0, None)
-        return np.exp(-d2 / (2 * s2)) / np.sqrt(2 * np.pi * s2)
+    def _distance2(self, hist: np.ndarray, template: np.ndarray) -> np.ndarray:
+        """Eq. 7: the squared Bhattacharyya distance of each histogram to a template."""
+        return np.clip(1.0 - bhattacharyya(hist, template), 0.0, None)
+
+    def _predict(self) -> np.ndarray:
+        """Where each target's particles are centred (eq. 3: a Brownian step from the previous estimate)."""
+        return self.estimates
+
+    def _settle(self, estimates: np.ndarray, best_distance2: np.ndarray) -> np.ndarray:
+        """The new estimates, given each target's weighted mean and its best particle's distance to its template."""
+        return estimates
 
     def update(self, obs) -> Tracks:
         p = self.params
@@ -68,10 +74,13 @@ class InteractiveParticleFilter(Tracker):
         k, n = len(self.ids), p["particles"]
         if self.templates is None:
             self.templates = [self._histograms(frame, c[None], s)[0] for c, s in zip(self.estimates, self.sizes)]
-        particles = self.estimates[:, None] + self.rng.normal(0, 1, (k, n, 2)) * self.sigma[:, None, None]
+        particles = self._predict()[:, None] + self.rng.normal(0, 1, (k, n, 2)) * self.sigma[:, None, None]
         hists = [self._histograms(frame, particles[t], self.sizes[t]) for t in range(k)]
-        # likelihood of every particle against every template: (targets, N, templates)
-        like = np.stack([np.stack([self._likelihood(h, tpl) for tpl in self.templates], axis=1) for h in hists])
+        # distance of every particle to every template, (targets, N, templates), and eq. 6's Gaussian likelihood
+        d2 = np.stack([np.stack([self._distance2(h, tpl) for tpl in self.templates], axis=1) for h in hists]) \
+            if k else np.zeros((0, n, 0))
+        s2 = p["sigma2"]
+        like = np.exp(-d2 / (2 * s2)) / np.sqrt(2 * np.pi * s2)
         own = like[np.arange(k), :, np.arange(k)] if k else np.zeros((0, n))
         weights = own.copy()
         if p["interactive"] and k > 1:
@@ -82,7 +91,8 @@ class InteractiveParticleFilter(Tracker):
             weights = np.where(hidden, best / distance, own)
         total = weights.sum(axis=1, keepdims=True)
         weights = np.where(total > 0, weights / np.where(total > 0, total, 1.0), 1.0 / n)
-        self.estimates = np.einsum("kn,knd->kd", weights, particles)
+        own_d2 = d2[np.arange(k), :, np.arange(k)] if k else np.zeros((0, n))
+        self.estimates = self._settle(np.einsum("kn,knd->kd", weights, particles), own_d2.min(axis=1, initial=1.0))
         self._cloud = (particles, weights)
         boxes = np.c_[self.estimates - self.sizes / 2, self.sizes]
         return Tracks.of(self.ids, boxes, weights.max(axis=1) if k else np.zeros(0))
@@ -91,3 +101,31 @@ class InteractiveParticleFilter(Tracker):
         """Each target's particles and their weights."""
         xy, w = self._cloud
         return [{"kind": "points", "xy": xy[t], "weights": w[t], "color": (255, 255, 0)} for t in range(len(xy))]
+
+
+@register
+class PathConsistencyParticleFilter(InteractiveParticleFilter):
+    """The baseline seed 002 compares against: independent particle filters (200 particles each, the paper's count
+    for it) that assume a consistent path. Particles are drawn around the constant-velocity prediction, and while a
+    target's best particle is farther than `occluded_distance` (squared Bhattacharyya distance) from its template
+    the target is taken as occluded and coasts on its velocity instead of following its weights."""
+
+    name = "pcpf"
+    description = "Seed 002's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
+    defaults = {**InteractiveParticleFilter.defaults, "particles": 200, "interactive": False,
+                "occluded_distance": 0.3, "velocity_gain": 0.3}
+
+    def reset(self, info=None):
+        super().reset(info)
+        self.velocity = np.zeros_like(self.estimates)
+        self.occluded = np.zeros(len(self.ids), bool)
+
+    def _predict(self) -> np.ndarray:
+        return self.estimates + self.velocity
+
+    def _settle(self, estimates: np.ndarray, best_distance2: np.ndarray) -> np.ndarray:
+        self.occluded = best_distance2 > self.params["occluded_distance"]
+        g = self.params["velocity_gain"]
+        velocity = (1 - g) * self.velocity + g * (estimates - self.estimates)
+        self.velocity = np.where(self.occluded[:, None], self.velocity, velocity)
+        return np.where(self.occluded[:, None], self.estimates + self.velocity, estimates)
