@@ -36,6 +36,8 @@ def test_bhattacharyya_values():
     q = np.array([0.5, 0.5, 0.0])
     p = np.array([[0.5, 0.5, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
     np.testing.assert_allclose(bhattacharyya(p, q), [1.0, 0.0, np.sqrt(0.5)])
+    both = np.stack([q, [0.0, 0.0, 1.0]])  # against several templates at once: one column each
+    np.testing.assert_allclose(bhattacharyya(p, both), [[1.0, 0.0], [0.0, 1.0], [np.sqrt(0.5), 0.0]])
 
 
 @pytest.mark.parametrize("edge, dominant", [("vertical", 0), ("horizontal", 2)])

@@ -83,6 +83,9 @@ def test_config_reference_and_perf_report_shape(capsys):
     rows = perf.measure_metrics(repeats=1)
     assert [r["objects"] for r in rows] == [20, 200] and all(r["update_us"] > 0 and r["summary_s"] > 0 for r in rows)
     assert "update / reference" in perf.report_metrics(rows)
+    rows = perf.measure_pf(repeats=1, frames=2)
+    assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf"] and all(r["fps"] > 0 for r in rows)
+    assert "| ipf (seed 002), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
 
 
 def test_sweep_writes_a_plot(tmp_path, capsys):

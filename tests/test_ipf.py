@@ -1,6 +1,9 @@
 """Seed 002's interactive particle filter: the conflict set by hand, and runs through gym.make."""
 
+import itertools
+
 import numpy as np
+import pytest
 
 import trackers
 from helpers import run_tracker, tiny
@@ -20,6 +23,22 @@ def test_conflict_set_on_hand_placed_regions():
     shifted = centres.copy()
     shifted[1, 0] = [3.0, 0.0]          # overlap 7/10 of the smaller region: no longer a conflict
     assert conflict_set(shifted, sizes, 0.75)[:, 0].tolist() == [False, False, True]  # target 2 still inside 1's
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_conflict_set_equals_the_plain_pair_loop(seed):
+    rng = np.random.default_rng(seed)
+    k, n = 4, 6
+    sizes = rng.uniform(5, 30, (k, 2))
+    centres = rng.uniform(0, 60, (k, 1, 2)) + rng.normal(0, 8, (k, n, 2))
+    expected = np.zeros((k, n), bool)
+    for a, i, b, j in itertools.product(range(k), range(n), range(k), range(n)):
+        if a != b:
+            lo = np.maximum(centres[a, i] - sizes[a] / 2, centres[b, j] - sizes[b] / 2)
+            hi = np.minimum(centres[a, i] + sizes[a] / 2, centres[b, j] + sizes[b] / 2)
+            inter = np.prod(np.clip(hi - lo, 0, None))
+            expected[a, i] |= inter / min(np.prod(sizes[a]), np.prod(sizes[b])) > 0.5
+    np.testing.assert_array_equal(conflict_set(centres, sizes, 0.5), expected)
 
 
 def test_runs_and_is_reproducible_with_and_without_interaction():

@@ -64,9 +64,12 @@ def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[i
 
 
 def bhattacharyya(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of seed 001);
-    only q's nonzero bins can contribute, so only they are read."""
+    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of seed 001),
+    or with every row of q (k, B) at once, (n, k). For one q only its nonzero bins can contribute, so only they
+    are read."""
     q = np.asarray(q)
+    if q.ndim == 2:
+        return np.sqrt(np.asarray(p)) @ np.sqrt(q).T
     nz = np.flatnonzero(q)
     return np.sqrt(np.asarray(p)[:, nz] * q[nz][None]).sum(axis=1)
 
