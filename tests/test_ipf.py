@@ -1,6 +1,7 @@
 """Seed 002's interactive particle filter: the conflict set by hand, and runs through gym.make."""
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -52,17 +53,7 @@ def test_runs_and_is_reproducible_with_and_without_interaction():
     np.testing.assert_allclose([cl["weights"].sum() for cl in clouds], 1.0)
 
 
-def crossing(color_b, occluder_color=(200, 60, 60), occluder_layer=1):
-    """A 40x40 book moving right and an 80x80 one moving left on top of it, crossing in mid-frame: the small one is
-    completely hidden for about 10 frames and comes out 20 px further right."""
-    def book(name, color, x, heading, size, layer, texture):
-        return {"name": name, "count": 1, "shape": "rect", "size": [size, size], "size_jitter": 0.0, "speed": 2.0,
-                "speed_jitter": 0.0, "heading": heading, "heading_jitter": 0.0, "accel": 0.0, "layer": layer,
-                "region": [x, 0.5, x + 0.001, 0.501], "color": list(color), "similarity": 1.0, "texture": texture}
-    return tiny(groups=[book("small", color_b, 0.2, 0.0, 40.0, 0, "checks"),
-                        book("large", occluder_color, 0.8, 180.0, 80.0, occluder_layer, "stripes")],
-                render={"width": 300, "height": 200, "background": "noise", "noise": 3.0},
-                world={"walls": False}, env={"max_steps": 70})
+EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"
 
 
 def final_errors(sc, spec):
@@ -86,7 +77,7 @@ def final_errors(sc, spec):
 def test_interactive_filter_keeps_a_look_alike_book_through_complete_occlusion_where_independent_filters_lose_it():
     # the hidden book's colour is close to its occluder's: an independent filter's particles latch onto the occluder
     # and leave with it; the interactive filter sees the occluder's template explain them better (eq. 4) and holds on
-    sc = crossing((210, 75, 60))
+    sc = str(EXPERIMENTS / "lookalike_crossing.toml")
     kept, least = final_errors(sc, "ipf")
     lost, _ = final_errors(sc, "ipf:interactive=false")
     assert least == 0.0                       # the small book was completely hidden
