@@ -54,7 +54,7 @@ class TrackingEnv(gym.Env):
     ``truncated`` after ``env.max_steps`` steps.
 
     **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
-    trackers initialised by hand. Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
+    trackers initialised by hand, and ``image_size`` (width, height). Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
     num_gt, similarity_sum); on the last step ``info["metrics"]``, the episode's MOTA, IDF1, HOTA, GOSPA
     and the rest (see ``mtt_sim.metrics``). ``env.unwrapped.truth`` is the current ground truth.
     """
@@ -122,7 +122,8 @@ class TrackingEnv(gym.Env):
         self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4), np.float32))
         obs = self.observe()
         seen = self.truth.visibility > 0
-        info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy()}
+        info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy(),
+                "image_size": (sc.render.width, sc.render.height)}
         return obs, info
 
     def _reconfigure(self, config: Mapping):

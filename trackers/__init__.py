@@ -6,7 +6,7 @@
     t.reset(info); tracks = t.update(obs); env.step(tracks.to_action(env.action_space))
 """
 
-from . import bytetrack, echo, gnn, iou, ipf, jpda, particle, sort  # noqa: F401  (each registers its tracker)
+from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, lmb, particle, sort  # noqa: F401  (each registers its tracker)
 from .base import Tracker, Tracks, available, make, parse_spec, register
 
 __all__ = ["Tracker", "Tracks", "available", "make", "parse_spec", "register"]

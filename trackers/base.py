@@ -47,6 +47,14 @@ class Tracks:
         return {"ids": padded_ids, "boxes": padded_boxes, "num_tracks": len(ids)}
 
 
+def covariance_ellipse(centre, cov: np.ndarray, scale2: float, color) -> dict:
+    """A debug ellipse primitive: the set d^2 = scale2 of the 2-D Gaussian with covariance `cov` around `centre`."""
+    eigval, eigvec = np.linalg.eigh(cov)
+    angle = float(np.degrees(np.arctan2(eigvec[1, 1], eigvec[0, 1])))
+    return {"kind": "ellipse", "center": centre, "axes": np.sqrt(scale2 * np.maximum(eigval[::-1], 0)), "angle": angle,
+            "color": color}
+
+
 def detections(obs: Mapping) -> np.ndarray:
     """The valid (n, 5) rows x, y, w, h, confidence of an observation, checked."""
     if not isinstance(obs, Mapping) or "detections" not in obs or "num_detections" not in obs:

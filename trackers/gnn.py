@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import assign, chi2_gate
-from .base import Tracker, Tracks, detections, register
+from .base import Tracker, Tracks, covariance_ellipse, detections, register
 from .kalman import KalmanBank, point_model
 from .trackbook import CONFIRMED, TENTATIVE, TrackBook
 
@@ -32,13 +32,7 @@ class Gnn(Tracker):
 
     def debug(self) -> list[dict]:
         """The validation gates of the last association: ellipses d^2 = gate around each predicted centre."""
-        out = []
-        for centre, S in zip(*self._gates):
-            eigval, eigvec = np.linalg.eigh(S)
-            angle = float(np.degrees(np.arctan2(eigvec[1, 1], eigvec[0, 1])))
-            out.append({"kind": "ellipse", "center": centre, "axes": np.sqrt(self.gate * eigval[::-1]),
-                        "angle": angle, "color": (0, 200, 255)})
-        return out
+        return [covariance_ellipse(centre, S, self.gate, (0, 200, 255)) for centre, S in zip(*self._gates)]
 
     def update(self, obs) -> Tracks:
         p, book = self.params, self.book

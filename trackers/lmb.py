@@ -1,0 +1,246 @@
+"""Seed 004 (Jiang, Yang): a labelled multi-Bernoulli filter with Gaussian-mixture densities, gating and grouping,
+Murty-ranked association hypotheses, and a birth model driven by the detections and their confidences."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from . import gaussian_mixture as gm
+from .assignment import chi2_gate, murty
+from .base import Tracker, Tracks, covariance_ellipse, detections, register
+
+EPS = 1e-12
+
+
+def group_of(gated: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+    """Independent groups of tracks (rows) and measurements (columns) linked by gates: (count, track group,
+    measurement group). A measurement in no gate gets its own group, as does a track with none."""
+    t, m = gated.shape
+    rows, cols = np.nonzero(gated)
+    graph = csr_matrix((np.ones(len(rows)), (rows, cols + t)), shape=(t + m, t + m))
+    count, labels = connected_components(graph, directed=False)
+    return count, labels[:t], labels[t:]
+
+
+def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: int) -> tuple[np.ndarray, np.ndarray]:
+    """The LMB update of one group (Reuter et al. 2014, sec. III): the predicted LMB is a delta-GLMB whose
+    association hypotheses are ranked by Murty's algorithm on the cost matrix [detections | missed | dead]
+    (rows: tracks). `log_r` (n,) log existence, `log_q` (n, m) log(q(z) / clutter density), -inf outside the gate.
+    Returns beta (n, m + 1): the probability that track i exists and took measurement j, or (last column) exists
+    and was missed; row sums are the posterior existence probabilities."""
+    n, m = log_q.shape
+    log_1mr = np.log1p(-np.minimum(np.exp(log_r), 1 - EPS))
+    if n == 1:  # one track: its m + 2 hypotheses in closed form (Murty would list the same ones)
+        log_w = np.r_[log_r[0] + np.log(pd) + log_q[0], log_r[0] + np.log1p(-pd), log_1mr[0]]
+        w = np.exp(log_w - log_w.max())
+        w /= w.sum()
+        return w[None, :-1]
+    cost = np.full((n, m + 2 * n), np.inf)
+    cost[:, :m] = -(log_r[:, None] + np.log(pd) + log_q)
+    rows = np.arange(n)
+    cost[rows, m + rows] = -(log_r + np.log1p(-pd))          # exists, missed
+    cost[rows, m + n + rows] = -log_1mr                        # does not exist
+    ranked = murty(cost, hypotheses)
+    totals = np.array([c for _, c in ranked])
+    weights = np.exp(-(totals - totals.min()))
+    weights /= weights.sum()
+    cols = np.stack([a for a, _ in ranked])                  # (hypotheses, n)
+    beta = np.zeros((n, m + 1))
+    target = np.where(cols < m, cols, np.where(cols < m + n, m, -1))  # -1: dead
+    alive = target >= 0
+    h, i = np.nonzero(alive)
+    np.add.at(beta, (i, target[h, i]), weights[h])
+    return beta
+
+
+class _Mixture:
+    """Every track's Bernoulli (existence r, label) and Gaussian mixture components, sorted by track."""
+
+    def __init__(self):
+        self.r, self.label, self.born = np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.track, self.w = np.zeros(0, np.intp), np.zeros(0)
+        self.m, self.P = np.zeros((0, gm.DIM)), np.zeros((0, gm.DIM, gm.DIM))
+
+    def add(self, r: np.ndarray, labels: np.ndarray, born: int, m: np.ndarray, P: np.ndarray) -> None:
+        """New tracks, one component each."""
+        start = len(self.r)
+        self.r, self.label = np.r_[self.r, r], np.r_[self.label, labels]
+        self.born = np.r_[self.born, np.full(len(r), born)]
+        self.track = np.r_[self.track, start + np.arange(len(r))]
+        self.w, self.m, self.P = np.r_[self.w, np.ones(len(r))], np.r_[self.m, m], np.concatenate([self.P, P])
+
+    def replace(self, r, track, w, m, P, keep_tracks: np.ndarray, max_components: int, prune: float) -> None:
+        """New existence per track and new components; drop tracks not in `keep_tracks` and, per track, components
+        under `prune` of its weight beyond the heaviest `max_components`; weights renormalised."""
+        new_index = np.full(len(r), -1)
+        new_index[keep_tracks] = np.arange(len(keep_tracks))
+        track = new_index[track]
+        ok = (track >= 0) & (w > 0)
+        track, w, m, P = track[ok], w[ok], m[ok], P[ok]
+        order = np.lexsort((-w, track))
+        track, w, m, P = track[order], w[order], m[order], P[order]
+        first = np.searchsorted(track, track)
+        total = np.bincount(track, w, minlength=len(keep_tracks))
+        keep = (np.arange(len(track)) - first < max_components) & (w >= prune * total[track])
+        track, w, m, P = track[keep], w[keep], m[keep], P[keep]
+        w = w / np.bincount(track, w, minlength=len(keep_tracks))[track]
+        self.r, self.label, self.born = r[keep_tracks], self.label[keep_tracks], self.born[keep_tracks]
+        self.track, self.w, self.m, self.P = track, w, m, P
+
+    def best(self) -> np.ndarray:
+        """Index of each track's heaviest component (components are sorted by track, heaviest first)."""
+        return np.searchsorted(self.track, np.arange(len(self.r)))
+
+
+@register
+class LabelledMultiBernoulli(Tracker):
+    """Labelled multi-Bernoulli filter (Reuter, Vo, Vo, Dietmayer 2014) as seed 004 uses it. Each track is a
+    Bernoulli with existence probability r and a Gaussian mixture over (x, y, w, h, vx, vy, vw, vh). Prediction
+    scales r by the survival probability; tracks and detections are gated (chi-square, `gate`) and split into
+    independent groups; each group is updated as a delta-GLMB whose `hypotheses` best association hypotheses come
+    from Murty's algorithm, then turned back into an LMB. Detections the tracks do not explain give birth at the
+    next frame with r_B = birth_max x confidence x (1 - probability the detection was associated), so a confident
+    unexplained detection starts a likely track and a doubtful one an unlikely track (sec. 4.2.1): low-confidence
+    detections stay in the filter. birth=fixed instead places `fixed_births` newborn components along the image
+    borders every frame (the traditional model). Tracks with r > `extract` are reported, tracks under `prune` are
+    dropped, and each keeps at most `max_components` components. use_low_confidence=false first drops detections
+    under `low_confidence` (the paper's Ours_2). Clutter is uniform over the image for x, y and over
+    [0, W/4] x [0, H/2] for w, h, at `clutter_rate` per frame."""
+
+    name = "lmb"
+    description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
+    defaults = {"survival": 0.98, "detection": 0.85, "clutter_rate": 5.0, "gate": 0.999, "hypotheses": 30,
+                "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16, "fixed_birth_r": 0.03, "extract": 0.5,
+                "prune": 1e-3, "max_components": 4, "use_low_confidence": True, "low_confidence": 0.5,
+                "measurement_noise": 0.05, "process_noise": 0.02}
+
+    def reset(self, info=None):
+        p = self.params
+        if p["birth"] not in ("adaptive", "fixed"):
+            raise ValueError(f"lmb: birth={p['birth']!r}: allowed values: 'adaptive', 'fixed'")
+        size = (info or {}).get("image_size")
+        if size is None or min(size) <= 0:
+            raise ValueError("lmb needs the image size (clutter density, border births): pass env.reset's info")
+        w, h = (float(v) for v in size)
+        self.image_size = (w, h)
+        self.log_clutter_density = np.log(p["clutter_rate"] / (w * h * (w / 4) * (h / 2)))
+        self.noise = gm.BoxNoise(p["measurement_noise"], p["process_noise"])
+        self.tracks = _Mixture()
+        self.pending = (np.zeros((0, 4)), np.zeros(0))  # births for the next frame: boxes, r_B
+        self.next_label, self.frame = 1, 0
+        self._beta = np.zeros((0, 1))
+
+    def _labels(self, n: int) -> np.ndarray:
+        out = np.arange(self.next_label, self.next_label + n)
+        self.next_label += n
+        return out
+
+    def _births(self, dets: np.ndarray) -> None:
+        """Add this frame's newborn tracks: last frame's unexplained detections, or the fixed border model."""
+        p, t = self.params, self.tracks
+        if p["birth"] == "fixed":
+            boxes, r = self._fixed_birth_boxes(dets), np.full(p["fixed_births"], p["fixed_birth_r"])
+            m, P = self.noise.birth(boxes)
+            P[:, 0, 0] = P[:, 1, 1] = (max(self.image_size) / p["fixed_births"]) ** 2  # anywhere along its border piece
+        else:
+            boxes, r = self.pending
+            m, P = self.noise.birth(boxes)
+        t.add(r, self._labels(len(r)), self.frame, m, P)
+
+    def _fixed_birth_boxes(self, dets: np.ndarray) -> np.ndarray:
+        """`fixed_births` boxes spread evenly around the image border, sized like this frame's median detection."""
+        w, h = self.image_size
+        bw, bh = np.median(dets[:, 2:4], axis=0) if len(dets) else (w / 20, h / 10)
+        s = np.linspace(0, 2 * (w + h), self.params["fixed_births"], endpoint=False)
+        x = np.select([s < w, s < w + h, s < 2 * w + h], [s, w, 2 * w + h - s], 0.0)
+        y = np.select([s < w, s < w + h, s < 2 * w + h], [0.0, s - w, h], 2 * (w + h) - s)
+        return np.stack([np.clip(x - bw / 2, 0, w - bw), np.clip(y - bh / 2, 0, h - bh), np.full_like(s, bw),
+                         np.full_like(s, bh)], axis=1)
+
+    def update(self, obs) -> Tracks:
+        p, t = self.params, self.tracks
+        dets = detections(obs)
+        if not p["use_low_confidence"]:
+            dets = dets[dets[:, 4] >= p["low_confidence"]]
+        z, conf = dets[:, :4], dets[:, 4]
+        self.frame += 1
+        if self.frame == 1 and p["birth"] == "adaptive":  # at the first frame every detection starts a track
+            self.pending = (z, p["birth_max"] * conf)
+        t.r = t.r * p["survival"]
+        t.m, t.P = gm.predict(t.m, t.P, self.noise)
+        self._births(dets)
+
+        inn = gm.Innovation.of(t.m, t.P, self.noise)
+        d2 = inn.distance2(z)
+        gated_c = d2 < chi2_gate(gm.MEAS, p["gate"])
+        log_l = np.where(gated_c, np.log(t.w)[:, None] + inn.log_likelihood(d2), -np.inf)   # (C, M)
+        n_tracks, n_meas = len(t.r), len(z)
+        log_q = np.full((n_tracks, n_meas), -np.inf)                                       # log q_i(z_j) per track
+        if len(t.track) and n_meas:  # log-sum-exp of each track's components
+            peak = np.maximum.reduceat(log_l, t.best(), axis=0)
+            safe = np.where(np.isfinite(peak), peak, 0.0)
+            with np.errstate(divide="ignore"):
+                log_q = safe + np.log(np.add.reduceat(np.exp(log_l - safe[t.track]), t.best(), axis=0))
+        gated = np.isfinite(log_q)
+        beta = self._association(gated, log_q - self.log_clutter_density)
+        self._beta = beta
+        r_new = beta.sum(axis=1)
+
+        # posterior mixtures: each component corrected by each measurement its track may have taken, plus missed
+        c, j = np.nonzero(gated_c & (beta[t.track, :n_meas] > 0))
+        w_det = np.exp(log_l[c, j] - log_q[t.track[c], j]) * beta[t.track[c], j]
+        miss = beta[t.track, n_meas]
+        track = np.r_[t.track[c], t.track]
+        weights = np.r_[w_det, t.w * miss] / np.maximum(r_new[track], EPS)
+        means = np.r_[inn.corrected_means(t.m, z, c, j), t.m]
+        covs = np.concatenate([inn.P[c], t.P])
+        keep = np.flatnonzero(r_new > p["prune"])
+        t.replace(r_new, track, weights, means, covs, keep, p["max_components"], p["prune"])
+
+        associated = beta[:, :n_meas].sum(axis=0) if n_tracks else np.zeros(n_meas)
+        r_birth = p["birth_max"] * conf * np.clip(1 - associated, 0, 1)
+        fresh = r_birth > p["prune"]
+        self.pending = (z[fresh], r_birth[fresh])
+        report = t.r > p["extract"]
+        best = t.best()[report]
+        return Tracks.of(t.label[report], t.m[best, :4], t.r[report])
+
+    def _association(self, gated: np.ndarray, log_q: np.ndarray) -> np.ndarray:
+        """beta (tracks, measurements + 1) for every group; a track with no measurement in its gate is missed or
+        gone in closed form."""
+        p, t = self.params, self.tracks
+        n, m = gated.shape
+        beta = np.zeros((n, m + 1))
+        pd = p["detection"]
+        lonely = ~gated.any(axis=1)
+        beta[lonely, m] = t.r[lonely] * (1 - pd) / (1 - t.r[lonely] * pd)
+        busy = np.flatnonzero(~lonely)
+        if not len(busy):
+            return beta
+        used = np.flatnonzero(gated[busy].any(axis=0))
+        count, track_group, meas_group = group_of(gated[np.ix_(busy, used)])
+        order = np.argsort(track_group, kind="stable")
+        bounds = np.searchsorted(track_group[order], np.arange(count + 1))
+        for g in range(count):
+            rows = busy[order[bounds[g]:bounds[g + 1]]]
+            if not len(rows):
+                continue
+            cols = used[meas_group == g]
+            b = group_update(np.log(np.maximum(t.r[rows], EPS)), log_q[np.ix_(rows, cols)], pd, p["hypotheses"])
+            beta[np.ix_(rows, cols)] = b[:, :-1]
+            beta[rows, m] = b[:, -1]
+        return beta
+
+    def debug(self) -> list[dict]:
+        """Each track's existence probability (as text) and the covariance ellipse of its position (2 sigma)."""
+        t = self.tracks
+        out = []
+        for k in t.best()[t.r > self.params["prune"] * 10]:
+            i = t.track[k]
+            x, y, w, h = t.m[k, :4]
+            colour = (0, 255, 0) if t.r[i] > self.params["extract"] else (160, 160, 160)
+            out.append(covariance_ellipse((x + w / 2, y + h / 2), t.P[k, :2, :2], 4.0, colour))
+            out.append({"kind": "text", "xy": (x, y - 3), "text": f"{t.label[i]}:{t.r[i]:.2f}", "color": colour})
+        return out
