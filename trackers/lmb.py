@@ -32,15 +32,16 @@ def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: in
     and was missed; row sums are the posterior existence probabilities."""
     n, m = log_q.shape
     log_1mr = np.log1p(-np.minimum(np.exp(log_r), 1 - EPS))
+    log_miss = np.log1p(-pd) if pd < 1 else -np.inf
     if n == 1:  # one track: its m + 2 hypotheses in closed form (Murty would list the same ones)
-        log_w = np.r_[log_r[0] + np.log(pd) + log_q[0], log_r[0] + np.log1p(-pd), log_1mr[0]]
+        log_w = np.r_[log_r[0] + np.log(pd) + log_q[0], log_r[0] + log_miss, log_1mr[0]]
         w = np.exp(log_w - log_w.max())
         w /= w.sum()
         return w[None, :-1]
     cost = np.full((n, m + 2 * n), np.inf)
     cost[:, :m] = -(log_r[:, None] + np.log(pd) + log_q)
     rows = np.arange(n)
-    cost[rows, m + rows] = -(log_r + np.log1p(-pd))          # exists, missed
+    cost[rows, m + rows] = -(log_r + log_miss)                 # exists, missed
     cost[rows, m + n + rows] = -log_1mr                        # does not exist
     ranked = murty(cost, hypotheses)
     totals = np.array([c for _, c in ranked])

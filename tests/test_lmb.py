@@ -1,0 +1,161 @@
+"""Seed 004's labelled multi-Bernoulli filter and the GM-PHD comparator: formulas with known answers, a plain
+Kalman filter, brute-force enumeration of hypotheses, and runs through gym.make."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+import trackers
+from helpers import placed, run_tracker, still, tiny
+from mtt_sim.env import TrackingEnv
+from trackers import gaussian_mixture as gm
+from trackers.lmb import group_update
+
+INFO = {"image_size": (640, 480)}
+
+
+def obs_of(*rows):
+    """An observation with detection rows (x, y, w, h, confidence)."""
+    dets = np.zeros((8, 5), np.float32)
+    if rows:
+        dets[: len(rows)] = rows
+    return {"detections": dets, "num_detections": len(rows)}
+
+
+def test_single_target_with_certain_detection_and_no_clutter_is_a_kalman_filter():
+    lmb = trackers.make("lmb", detection=1.0, survival=1.0, clutter_rate=1e-6)
+    lmb.reset(INFO)
+    noise = gm.BoxNoise(0.05, 0.02)
+    rng = np.random.default_rng(0)
+    truth = np.array([100.0, 80.0, 30.0, 60.0])
+    x = P = None
+    for k in range(15):
+        z = (truth + [2.0 * k, 1.0 * k, 0, 0] + rng.normal(0, 1.5, 4)).astype(np.float32).astype(float)
+        if x is None:   # the plain filter: born at the first detection, then corrected by it (as lmb does)
+            x, P = noise.birth(z[None])
+            x, P = x[0], P[0]
+        else:
+            x = gm.F @ x
+            P = gm.F @ P @ gm.F.T + noise.process_covariance(x[None])[0]
+        S = gm.H @ P @ gm.H.T + noise.measurement_covariance(x[None])[0]
+        K = P @ gm.H.T @ np.linalg.inv(S)
+        x, P = x + K @ (z - gm.H @ x), (np.eye(gm.DIM) - K @ gm.H) @ P
+        tracks = lmb.update(obs_of([*z, 0.9]))
+        assert len(tracks.ids) == 1 and tracks.ids[0] == 1
+        np.testing.assert_allclose(tracks.boxes[0], x[:4], rtol=1e-6)
+        np.testing.assert_allclose(lmb.tracks.m[0], x, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(lmb.tracks.P[0], P, rtol=1e-9, atol=1e-9)
+
+
+def test_existence_decays_with_misses_at_the_rate_of_the_formula():
+    lmb = trackers.make("lmb", detection=0.8, survival=0.95, prune=1e-9)
+    lmb.reset(INFO)
+    lmb.update(obs_of([100, 100, 30, 60, 0.9]))
+    r = lmb.tracks.r[0]
+    rates = []
+    for _ in range(6):
+        lmb.update(obs_of())
+        r_pred = 0.95 * r
+        expected = r_pred * 0.2 / (1 - r_pred * 0.8)        # missed: r (1 - P_D) / (1 - r P_D) after survival
+        assert lmb.tracks.r[0] == pytest.approx(expected, rel=1e-12)
+        rates.append(expected / r)
+        r = expected
+    assert all(a > b for a, b in zip(rates, rates[1:]))     # the less certain, the faster it fades... relatively
+
+
+def test_existence_rises_with_repeated_detections_and_a_birth_needs_an_unexplained_detection():
+    lmb = trackers.make("lmb")
+    lmb.reset(INFO)
+    assert len(lmb.update(obs_of()).ids) == 0
+    assert len(lmb.update(obs_of([300, 200, 30, 60, 0.9])).ids) == 0   # pending birth, nothing to report yet
+    assert lmb.pending[1] == pytest.approx([0.6 * 0.9])                  # r_B = birth_max x confidence
+    history = []
+    for k in range(5):
+        lmb.update(obs_of([300 + k, 200, 30, 60, 0.9]))
+        history.append(lmb.tracks.r[lmb.tracks.label == 1][0])
+    assert all(b > a for a, b in zip(history, history[1:])) and history[-1] > 0.99
+    assert len(lmb.pending[0]) == 0    # an explained detection gives no birth
+
+
+def brute_force_beta(log_r, log_q, pd):
+    """Every joint hypothesis of a group enumerated: each track takes a distinct measurement, is missed or is dead."""
+    n, m = log_q.shape
+    r = np.exp(log_r)
+    beta, total = np.zeros((n, m + 1)), 0.0
+    for choice in itertools.product(range(m + 2), repeat=n):
+        taken = [c for c in choice if c < m]
+        if len(taken) != len(set(taken)):
+            continue
+        w = 1.0
+        for i, c in enumerate(choice):
+            w *= r[i] * pd * np.exp(log_q[i, c]) if c < m else (r[i] * (1 - pd) if c == m else 1 - r[i])
+        total += w
+        for i, c in enumerate(choice):
+            if c <= m:
+                beta[i, c] += w
+    return beta / total
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_group_update_equals_enumeration_and_grouping_changes_nothing(seed):
+    rng = np.random.default_rng(seed)
+    log_r = np.log(rng.uniform(0.2, 0.95, 4))
+    log_q = rng.normal(1.0, 1.5, (4, 3))
+    log_q[:2, 2] = log_q[2:, :2] = -np.inf      # two groups: tracks 0, 1 with z0, z1; tracks 2, 3 with z2
+    full = group_update(log_r, log_q, 0.8, hypotheses=1000)
+    np.testing.assert_allclose(full, brute_force_beta(log_r, log_q, 0.8), atol=1e-12)
+    first = group_update(log_r[:2], log_q[:2, :2], 0.8, hypotheses=1000)
+    second = group_update(log_r[2:], log_q[2:, 2:], 0.8, hypotheses=1000)
+    np.testing.assert_allclose(full[:2, [0, 1, 3]], first, atol=1e-12)
+    np.testing.assert_allclose(full[2:, [2, 3]], second, atol=1e-12)
+    one = group_update(log_r[:1], log_q[:1, :2], 0.8, hypotheses=1000)   # the closed form of a lone track
+    np.testing.assert_allclose(one, brute_force_beta(log_r[:1], log_q[:1, :2], 0.8), atol=1e-12)
+
+
+def crossing_scene():
+    walker = {"count": 1, "size": [30.0, 60.0], "size_jitter": 0.0, "speed": 2.0, "speed_jitter": 0.0,
+              "heading_jitter": 0.0, "accel": 0.0}
+    return tiny(groups=[{**walker, "name": "a", "heading": 0.0, "region": [0.1, 0.45, 0.101, 0.451]},
+                        {**walker, "name": "b", "heading": 180.0, "region": [0.9, 0.5, 0.901, 0.501]}],
+                render={"width": 300, "height": 150}, world={"walls": False, "collision": "none"},
+                env={"max_steps": 110})
+
+
+@pytest.mark.parametrize("spec", ["lmb", "gmphd"])
+def test_labels_survive_a_crossing(spec):
+    env = TrackingEnv(crossing_scene())
+    obs, info = env.reset(seed=0)
+    tracker = trackers.make(spec)
+    tracker.reset(info)
+    while True:
+        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
+        if term or trunc:
+            break
+    m = info["metrics"]
+    assert m["IDSW"] == 0 and m["num_tracker_ids"] == 2 and m["MOTA"] > 0.9
+
+
+def test_gmphd_cardinality_on_a_static_scene_converges_to_the_true_count():
+    env = placed(tiny(groups=[still(count=3, size=(30.0, 30.0))]), [(40, 50), (100, 50), (160, 50)])
+    obs = env.observe()
+    phd = trackers.make("gmphd", detection=0.99)  # the scene's detector misses nothing
+    phd.reset({"image_size": (200, 100)})
+    counts, reported = [], []
+    for _ in range(25):
+        reported.append(len(phd.update(obs).ids))
+        counts.append(phd.w.sum())
+    assert counts[0] == 0 and reported[0] == 0               # births wait for the next frame
+    assert np.allclose(counts[-10:], 3, atol=0.05) and reported[-10:] == [3] * 10
+
+
+def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_size():
+    a, tracker = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60})
+    b, _ = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60})
+    assert a == b and a["MOTA"] > 0.5
+    drawn = tracker.debug()
+    assert {d["kind"] for d in drawn} == {"ellipse", "text"}
+    with pytest.raises(ValueError, match="image size"):
+        trackers.make("lmb").reset({})
+    with pytest.raises(ValueError, match="birth='sometimes': allowed values: 'adaptive', 'fixed'"):
+        trackers.make("lmb:birth=sometimes").reset(INFO)
