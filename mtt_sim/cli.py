@@ -100,6 +100,8 @@ def cmd_perf(args) -> int:
     print()
     print(perf.report_jpda(perf.measure_jpda(repeats=args.repeats)))
     print()
+    print(perf.report_lmb(perf.measure_lmb(repeats=args.repeats)))
+    print()
     print(perf.report_pf(perf.measure_pf(repeats=args.repeats)))
     return 0
 

@@ -126,22 +126,23 @@ def report_metrics(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
-def _recorded_detections(n: int, frames: int) -> list[dict]:
-    """Observations of `n` targets with P_D = 0.9 and Poisson clutter 5 per frame, recorded once."""
-    env = TrackingEnv("clutter_storm", config={"groups.0.count": n, "sensor.pd": 0.9, "sensor.clutter_rate": 5.0,
+def _recorded_detections(n: int, frames: int, clutter: float = 5.0) -> tuple[dict, list[dict]]:
+    """env.reset's info and the observations of `n` targets with P_D = 0.9 and Poisson clutter, recorded once."""
+    env = TrackingEnv("clutter_storm", config={"groups.0.count": n, "sensor.pd": 0.9, "sensor.clutter_rate": clutter,
                                                "sensor.min_visibility": 0.0, "env.max_steps": frames},
                       obs_mode="detections")
-    obs, _ = env.reset(seed=0)
+    obs, info = env.reset(seed=0)
     out = []
     for _ in range(frames):
         out.append({k: v.copy() if hasattr(v, "copy") else v for k, v in obs.items()})
         obs = env.step({"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))})[0]
-    return out
+    return info, out
 
 
-def _ms_per_frame(spec: str, observations: list[dict]) -> float:
+def _ms_per_frame(spec: str, recorded: tuple[dict, list[dict]]) -> float:
+    info, observations = recorded
     tracker = trackers.make(spec)
-    tracker.reset({})
+    tracker.reset(info)
     return _time(lambda: [tracker.update(o) for o in observations]) / len(observations) * 1e3
 
 
@@ -149,8 +150,8 @@ def measure_jpda(repeats: int = 5, frames: int = 150) -> list[dict]:
     """Medians of jpda's milliseconds per frame (tracker time only) at 10, 20 and 50 targets, against gnn."""
     rows = []
     for n in (10, 20, 50):
-        obs = _recorded_detections(n, frames)
-        runs = [(_ms_per_frame("jpda", obs), _ms_per_frame("gnn", obs)) for _ in range(repeats)]
+        rec = _recorded_detections(n, frames)
+        runs = [(_ms_per_frame("jpda", rec), _ms_per_frame("gnn", rec)) for _ in range(repeats)]
         jpda, gnn = (statistics.median(r[i] for r in runs) for i in range(2))
         rows.append({"targets": n, "jpda_ms": jpda, "gnn_ms": gnn, "jpda_over_gnn": jpda / gnn})
     return rows
@@ -160,6 +161,25 @@ def report_jpda(rows: list[dict]) -> str:
     out = ["jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
            "| targets | jpda ms/frame | gnn ms/frame | jpda / gnn |", "|---:|---:|---:|---:|"]
     out += [f"| {r['targets']} | {r['jpda_ms']:.2f} | {r['gnn_ms']:.2f} | {r['jpda_over_gnn']:.2f}x |" for r in rows]
+    return "\n".join(out)
+
+
+def measure_lmb(repeats: int = 5, frames: int = 100) -> list[dict]:
+    """Medians of lmb's milliseconds per frame (tracker time only) at 10, 30 and 100 targets with 10 clutter a
+    frame, against gnn on the same detections."""
+    rows = []
+    for n in (10, 30, 100):
+        rec = _recorded_detections(n, frames, clutter=10.0)
+        runs = [(_ms_per_frame("lmb", rec), _ms_per_frame("gnn", rec)) for _ in range(repeats)]
+        lmb, gnn = (statistics.median(r[i] for r in runs) for i in range(2))
+        rows.append({"targets": n, "lmb_ms": lmb, "gnn_ms": gnn, "lmb_over_gnn": lmb / gnn})
+    return rows
+
+
+def report_lmb(rows: list[dict]) -> str:
+    out = ["lmb tracker time per frame, medians (P_D 0.9, 10 clutter a frame, detections only; reference: gnn)",
+           "| targets | lmb ms/frame | gnn ms/frame | lmb / gnn |", "|---:|---:|---:|---:|"]
+    out += [f"| {r['targets']} | {r['lmb_ms']:.2f} | {r['gnn_ms']:.2f} | {r['lmb_over_gnn']:.2f}x |" for r in rows]
     return "\n".join(out)
 
 

@@ -4,56 +4,57 @@ Murty-ranked association hypotheses, and a birth model driven by the detections 
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 from . import gaussian_mixture as gm
 from .assignment import chi2_gate, murty
 from .base import Tracker, Tracks, covariance_ellipse, detections, register
+from .jpda import clusters
 
 EPS = 1e-12
+ENUMERATE_UP_TO = 512  # groups with at most this many candidate hypotheses (an upper bound) are enumerated
 
 
-def group_of(gated: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
-    """Independent groups of tracks (rows) and measurements (columns) linked by gates: (count, track group,
-    measurement group). A measurement in no gate gets its own group, as does a track with none."""
-    t, m = gated.shape
-    rows, cols = np.nonzero(gated)
-    graph = csr_matrix((np.ones(len(rows)), (rows, cols + t)), shape=(t + m, t + m))
-    count, labels = connected_components(graph, directed=False)
-    return count, labels[:t], labels[t:]
+def factor_table(log_r: np.ndarray, log_q: np.ndarray, pd: float) -> np.ndarray:
+    """(n, m + 2) log factors of each track's choices: measurement j (r pD q_j / kappa), missed (r (1 - pD)),
+    dead (1 - r)."""
+    log_1mr = np.log1p(-np.minimum(np.exp(log_r), 1 - EPS))
+    log_miss = np.log1p(-pd) if pd < 1 else -np.inf
+    return np.c_[log_r[:, None] + np.log(pd) + log_q, log_r + log_miss, log_1mr]
 
 
-def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: int) -> tuple[np.ndarray, np.ndarray]:
+def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: int) -> np.ndarray:
     """The LMB update of one group (Reuter et al. 2014, sec. III): the predicted LMB is a delta-GLMB whose
-    association hypotheses are ranked by Murty's algorithm on the cost matrix [detections | missed | dead]
-    (rows: tracks). `log_r` (n,) log existence, `log_q` (n, m) log(q(z) / clutter density), -inf outside the gate.
+    `hypotheses` best association hypotheses are kept, then turned back into an LMB. A hypothesis gives each track
+    a measurement (none twice), "missed" or "dead", with weight prod r pD q / kappa, r (1 - pD) or 1 - r.
+    `log_r` (n,) log existence, `log_q` (n, m) log(q(z) / clutter density), -inf outside the gate.
+    Murty's algorithm ranks them on the cost matrix [detections | missed | dead]; a group with at most
+    ENUMERATE_UP_TO candidate hypotheses lists them all and keeps the same best ones without it.
     Returns beta (n, m + 1): the probability that track i exists and took measurement j, or (last column) exists
     and was missed; row sums are the posterior existence probabilities."""
     n, m = log_q.shape
-    log_1mr = np.log1p(-np.minimum(np.exp(log_r), 1 - EPS))
-    log_miss = np.log1p(-pd) if pd < 1 else -np.inf
-    if n == 1:  # one track: its m + 2 hypotheses in closed form (Murty would list the same ones)
-        log_w = np.r_[log_r[0] + np.log(pd) + log_q[0], log_r[0] + log_miss, log_1mr[0]]
-        w = np.exp(log_w - log_w.max())
-        w /= w.sum()
-        return w[None, :-1]
-    cost = np.full((n, m + 2 * n), np.inf)
-    cost[:, :m] = -(log_r[:, None] + np.log(pd) + log_q)
-    rows = np.arange(n)
-    cost[rows, m + rows] = -(log_r + log_miss)                 # exists, missed
-    cost[rows, m + n + rows] = -log_1mr                        # does not exist
-    ranked = murty(cost, hypotheses)
-    totals = np.array([c for _, c in ranked])
-    weights = np.exp(-(totals - totals.min()))
+    table = factor_table(log_r, log_q, pd)
+    options = [np.flatnonzero(np.isfinite(row)) for row in table]
+    if np.prod([float(len(o)) for o in options]) <= ENUMERATE_UP_TO:
+        choice = np.stack(np.meshgrid(*options, indexing="ij"), axis=-1).reshape(-1, n)
+        distinct = np.sort(np.where(choice < m, choice, m + 2 + np.arange(n)), axis=1)
+        choice = choice[(np.diff(distinct, axis=1) != 0).all(axis=1)]
+        log_w = table[np.arange(n), choice].sum(axis=1)
+        if len(log_w) > hypotheses:
+            top = np.argpartition(-log_w, hypotheses - 1)[:hypotheses]
+            choice, log_w = choice[top], log_w[top]
+    else:
+        cost = np.full((n, m + 2 * n), np.inf)
+        rows = np.arange(n)
+        cost[:, :m], cost[rows, m + rows], cost[rows, m + n + rows] = -table[:, :m], -table[:, m], -table[:, m + 1]
+        ranked = murty(cost, hypotheses)
+        cols = np.stack([c for c, _ in ranked])
+        choice = np.where(cols < m, cols, np.where(cols < m + n, m, m + 1))
+        log_w = -np.array([c for _, c in ranked])
+    weights = np.exp(log_w - log_w.max())
     weights /= weights.sum()
-    cols = np.stack([a for a, _ in ranked])                  # (hypotheses, n)
-    beta = np.zeros((n, m + 1))
-    target = np.where(cols < m, cols, np.where(cols < m + n, m, -1))  # -1: dead
-    alive = target >= 0
-    h, i = np.nonzero(alive)
-    np.add.at(beta, (i, target[h, i]), weights[h])
-    return beta
+    beta = np.zeros((n, m + 2))
+    np.add.at(beta, (np.broadcast_to(np.arange(n), choice.shape), choice), weights[:, None])
+    return beta[:, :-1]
 
 
 class _Mixture:
@@ -221,15 +222,19 @@ class LabelledMultiBernoulli(Tracker):
         if not len(busy):
             return beta
         used = np.flatnonzero(gated[busy].any(axis=0))
-        count, track_group, meas_group = group_of(gated[np.ix_(busy, used)])
-        order = np.argsort(track_group, kind="stable")
-        bounds = np.searchsorted(track_group[order], np.arange(count + 1))
-        for g in range(count):
-            rows = busy[order[bounds[g]:bounds[g + 1]]]
-            if not len(rows):
-                continue
+        track_group, meas_group = clusters(gated[np.ix_(busy, used)])
+        log_r = np.log(np.maximum(t.r, EPS))
+        # a track alone in its group with few options: all its hypotheses at once, for every such track
+        alone = np.bincount(track_group)[track_group] == 1
+        alone &= gated[busy].sum(axis=1) + 2 <= p["hypotheses"]
+        rows = busy[alone]
+        table = factor_table(log_r[rows], log_q[rows], pd)
+        w = np.exp(table - table.max(axis=1, keepdims=True))
+        beta[rows] = (w / w.sum(axis=1, keepdims=True))[:, :-1]
+        for g in np.unique(track_group[~alone]):
+            rows = busy[track_group == g]
             cols = used[meas_group == g]
-            b = group_update(np.log(np.maximum(t.r[rows], EPS)), log_q[np.ix_(rows, cols)], pd, p["hypotheses"])
+            b = group_update(log_r[rows], log_q[np.ix_(rows, cols)], pd, p["hypotheses"])
             beta[np.ix_(rows, cols)] = b[:, :-1]
             beta[rows, m] = b[:, -1]
         return beta
