@@ -106,6 +106,15 @@ def cmd_perf(args) -> int:
     return 0
 
 
+def cmd_learn_reid(args) -> int:
+    from . import learn_reid
+    summary = learn_reid.learn(args.scenario, range(args.first_seed, args.first_seed + args.seeds), args.frames,
+                               args.every, args.dims, args.out)
+    for k, v in summary.items():
+        print(f"{k:12s} {v}")
+    return 0
+
+
 def cmd_config(args) -> int:
     if args.scenario:
         print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, parse_overrides(args.config))), indent=2))
@@ -150,6 +159,16 @@ def build_parser() -> argparse.ArgumentParser:
     pf.add_argument("--repeats", type=int, default=5)
     pf.add_argument("--steps", type=int, default=200)
     pf.set_defaults(func=cmd_perf)
+    lr = sub.add_parser("learn-reid", help="learn lmb's XQDA re-identification metric from rendered crops")
+    lr.add_argument("--scenario", default="mot17_like")
+    lr.add_argument("--first-seed", type=int, default=1000, help="training seeds start here (default 1000, away "
+                                                                   "from the experiments' 0..9)")
+    lr.add_argument("--seeds", type=int, default=4)
+    lr.add_argument("--frames", type=int, default=300)
+    lr.add_argument("--every", type=int, default=15, help="take crops every this many frames")
+    lr.add_argument("--dims", type=int, default=16, help="XQDA subspace dimension")
+    lr.add_argument("--out", default=None, help="where to write (default: the file the package ships)")
+    lr.set_defaults(func=cmd_learn_reid)
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
     cf.add_argument("scenario", nargs="?")
     cf.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE")

@@ -24,9 +24,9 @@ def obs_of(*rows):
 
 
 def test_single_target_with_certain_detection_and_no_clutter_is_a_kalman_filter():
-    lmb = trackers.make("lmb", detection=1.0, survival=1.0, clutter_rate=1e-6)
+    lmb = trackers.make("lmb", detection=1.0, survival=1.0, clutter_rate=1e-6, reid=False)
     lmb.reset(INFO)
-    noise = gm.BoxNoise(0.05, 0.02)
+    noise = gm.BoxNoise(lmb.params["measurement_noise"], lmb.params["process_noise"])
     rng = np.random.default_rng(0)
     truth = np.array([100.0, 80.0, 30.0, 60.0])
     x = P = None
@@ -49,7 +49,7 @@ def test_single_target_with_certain_detection_and_no_clutter_is_a_kalman_filter(
 
 
 def test_existence_decays_with_misses_at_the_rate_of_the_formula():
-    lmb = trackers.make("lmb", detection=0.8, survival=0.95, prune=1e-9)
+    lmb = trackers.make("lmb", detection=0.8, survival=0.95, prune=1e-9, reid=False)
     lmb.reset(INFO)
     lmb.update(obs_of([100, 100, 30, 60, 0.9]))
     r = lmb.tracks.r[0]
@@ -64,17 +64,27 @@ def test_existence_decays_with_misses_at_the_rate_of_the_formula():
     assert all(a > b for a, b in zip(rates, rates[1:]))     # the less certain, the faster it fades... relatively
 
 
-def test_existence_rises_with_repeated_detections_and_a_birth_needs_an_unexplained_detection():
-    lmb = trackers.make("lmb")
+def test_existence_rises_with_detections_at_the_rate_of_the_formula_and_a_birth_needs_an_unexplained_one():
+    lmb = trackers.make("lmb", reid=False, clutter_rate=50.0, prune=0.05)  # no second birth at the same place
     lmb.reset(INFO)
     assert len(lmb.update(obs_of()).ids) == 0
-    assert len(lmb.update(obs_of([300, 200, 30, 60, 0.9])).ids) == 0   # pending birth, nothing to report yet
-    assert lmb.pending[1] == pytest.approx([0.6 * 0.9])                  # r_B = birth_max x confidence
+    assert len(lmb.update(obs_of([300, 200, 30, 60, 0.3])).ids) == 0   # pending birth, nothing to report yet
+    assert lmb.pending[1] == pytest.approx([0.6 * 0.3])                  # r_B = birth_max x confidence
+    p, t = lmb.params, lmb.tracks
     history = []
-    for k in range(5):
-        lmb.update(obs_of([300 + k, 200, 30, 60, 0.9]))
-        history.append(lmb.tracks.r[lmb.tracks.label == 1][0])
-    assert all(b > a for a, b in zip(history, history[1:])) and history[-1] > 0.99
+    for k in range(4):
+        z = np.array([[300.0 + k, 200, 30, 60]])
+        if len(t.r):   # on the track's own predicted Gaussian: (r pD q / k + r (1 - pD)) / (r pD q / k + 1 - r pD)
+            m, P = gm.predict(t.m, t.P, lmb.noise)
+            inn = gm.Innovation.of(m, P, lmb.noise)
+            q = np.exp(inn.log_likelihood(inn.distance2(z))[0, 0] - lmb.log_clutter_density)
+            r, pd = p["survival"] * t.r[0], p["detection"]
+            expected = (r * pd * q + r * (1 - pd)) / (r * pd * q + 1 - r * pd)
+        lmb.update(obs_of([*z[0], 0.3]))
+        if k:
+            assert t.r[0] == pytest.approx(expected, rel=1e-9)
+        history.append(t.r[0])
+    assert history[0] > 0.6 * 0.3 and min(history) > 0.99   # up from r_B at the first hit, then held near one
     assert len(lmb.pending[0]) == 0    # an explained detection gives no birth
 
 
@@ -122,7 +132,7 @@ def crossing_scene():
                 env={"max_steps": 110})
 
 
-@pytest.mark.parametrize("spec", ["lmb", "gmphd"])
+@pytest.mark.parametrize("spec", ["lmb:reid=false", "gmphd"])
 def test_labels_survive_a_crossing(spec):
     env = TrackingEnv(crossing_scene())
     obs, info = env.reset(seed=0)
@@ -150,8 +160,8 @@ def test_gmphd_cardinality_on_a_static_scene_converges_to_the_true_count():
 
 
 def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_size():
-    a, tracker = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60})
-    b, _ = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60})
+    a, tracker = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60}, obs_mode="frame+detections")
+    b, _ = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60}, obs_mode="frame+detections")
     assert a == b and a["MOTA"] > 0.5
     drawn = tracker.debug()
     assert {d["kind"] for d in drawn} == {"ellipse", "text"}
@@ -159,3 +169,27 @@ def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_siz
         trackers.make("lmb").reset({})
     with pytest.raises(ValueError, match="birth='sometimes': allowed values: 'adaptive', 'fixed'"):
         trackers.make("lmb:birth=sometimes").reset(INFO)
+
+
+@pytest.mark.parametrize("reid, switches", [(True, 0), (False, 1)])
+def test_reid_restores_the_label_of_a_target_that_was_hidden_long_enough_to_be_forgotten(reid, switches):
+    # a walker passes behind a wide board: 45 frames without a detection, so its track is pruned; re-id gives the
+    # track born when it comes out the label it had
+    walker = {"name": "w", "count": 1, "size": [30.0, 60.0], "size_jitter": 0.0, "speed": 2.0, "speed_jitter": 0.0,
+              "heading": 0.0, "heading_jitter": 0.0, "accel": 0.0, "region": [0.1, 0.5, 0.101, 0.501],
+              "color": [40, 90, 200], "similarity": 1.0, "texture": "stripes"}
+    sc = tiny(groups=[walker], occluders=[{"rect": [100.0, 20.0, 120.0, 110.0], "color": [120, 120, 120]}],
+              sensor={"min_visibility": 0.5}, render={"width": 300, "height": 150, "background": "noise"},
+              world={"walls": False}, env={"max_steps": 115})
+    env = TrackingEnv(sc, obs_mode="frame+detections")
+    obs, info = env.reset(seed=0)
+    tracker = trackers.make("lmb", reid=reid)
+    tracker.reset(info)
+    hidden = 0
+    while True:
+        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
+        hidden += int(obs["num_detections"]) == 0
+        if term or trunc:
+            break
+    m = info["metrics"]
+    assert hidden >= 40 and m["IDSW"] == switches and m["num_tracker_ids"] == 1 + switches

@@ -26,9 +26,8 @@ class GaussianMixturePhd(Tracker):
 
     name = "gmphd"
     description = "GM-PHD filter (Vo and Ma 2006), measurement-driven birth, labels tagged through updates"
-    defaults = {"survival": 0.98, "detection": 0.85, "clutter_rate": 5.0, "gate": 0.999, "birth_weight": 0.3,
-                "prune": 1e-4, "merge": 4.0, "max_components": 200, "extract": 0.5, "measurement_noise": 0.05,
-                "process_noise": 0.02}
+    defaults = {**gm.MODEL_DEFAULTS, "birth_weight": 0.3, "prune": 1e-4, "merge": 4.0, "max_components": 200,
+                "extract": 0.5}
 
     def reset(self, info=None):
         size = (info or {}).get("image_size")

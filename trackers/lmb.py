@@ -6,9 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import gaussian_mixture as gm
+from . import reid
 from .assignment import chi2_gate, murty
 from .base import Tracker, Tracks, covariance_ellipse, detections, register
 from .jpda import clusters
+from .particle import frame_of
 
 EPS = 1e-12
 ENUMERATE_UP_TO = 512  # groups with at most this many candidate hypotheses (an upper bound) are enumerated
@@ -109,14 +111,23 @@ class LabelledMultiBernoulli(Tracker):
     borders every frame (the traditional model). Tracks with r > `extract` are reported, tracks under `prune` are
     dropped, and each keeps at most `max_components` components. use_low_confidence=false first drops detections
     under `low_confidence` (the paper's Ours_2). Clutter is uniform over the image for x, y and over
-    [0, W/4] x [0, H/2] for w, h, at `clutter_rate` per frame."""
+    [0, W/4] x [0, H/2] for w, h, at `clutter_rate` per frame.
+    Re-identification (sec. 3, 4.4; reid=false turns it off): every `pool_every` frames a reported track whose
+    most likely measurement has confidence >= `reid_confidence` puts that detection's LOMO feature (XQDA-embedded)
+    with its label in a FIFO pool of `pool_per_target` x (targets of the first frame) entries; a track reported
+    for the first time takes the label of the nearest pooled feature within `reid_threshold` whose label is not
+    in use. Re-identification reads the video frame."""
 
     name = "lmb"
     description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
-    defaults = {"survival": 0.98, "detection": 0.85, "clutter_rate": 5.0, "gate": 0.999, "hypotheses": 30,
+    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 30,
                 "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16, "fixed_birth_r": 0.03, "extract": 0.5,
-                "prune": 1e-3, "max_components": 4, "use_low_confidence": True, "low_confidence": 0.5,
-                "measurement_noise": 0.05, "process_noise": 0.02}
+                "prune": 1e-3, "max_components": 4, "use_low_confidence": True, "low_confidence": 0.5, "reid": True, "reid_confidence": 0.7,
+                "reid_threshold": 5.0, "pool_per_target": 10, "pool_every": 10}
+
+    @property
+    def needs_frame(self) -> bool:
+        return bool(self.params["reid"])
 
     def reset(self, info=None):
         p = self.params
@@ -133,6 +144,9 @@ class LabelledMultiBernoulli(Tracker):
         self.pending = (np.zeros((0, 4)), np.zeros(0))  # births for the next frame: boxes, r_B
         self.next_label, self.frame = 1, 0
         self._beta = np.zeros((0, 1))
+        self.metric = reid.Metric.shipped() if p["reid"] else None
+        self.pool = None                      # made at the first frame, sized by its target count
+        self.reported: set[int] = set()
 
     def _labels(self, n: int) -> np.ndarray:
         out = np.arange(self.next_label, self.next_label + n)
@@ -206,8 +220,33 @@ class LabelledMultiBernoulli(Tracker):
         fresh = r_birth > p["prune"]
         self.pending = (z[fresh], r_birth[fresh])
         report = t.r > p["extract"]
+        if self.metric is not None:
+            self._reidentify(frame_of(obs), report, beta[keep], dets)
         best = t.best()[report]
         return Tracks.of(t.label[report], t.m[best, :4], t.r[report])
+
+    def _reidentify(self, frame: np.ndarray, report: np.ndarray, beta: np.ndarray, dets: np.ndarray) -> None:
+        """Relabel tracks reported for the first time from the pool; then pool confident associated detections."""
+        p, t = self.params, self.tracks
+        n_meas = len(dets)
+        likely = np.argmax(beta[:, :n_meas], axis=1) if n_meas else np.zeros(len(t.r), int)
+        held = beta[np.arange(len(t.r)), likely] > 0.5 * t.r if n_meas else np.zeros(len(t.r), bool)
+        if self.pool is None:
+            self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, int(report.sum())))
+        new = np.flatnonzero(report & ~np.isin(t.label, list(self.reported)))
+        if len(new) and self.frame > 1:
+            boxes = np.where(held[new, None], dets[likely[new], :4] if n_meas else 0, t.m[t.best()[new], :4])
+            found = self.pool.match(self.metric, self._embed(frame, boxes), set(t.label.tolist()), p["reid_threshold"])
+            t.label[new[found > 0]] = found[found > 0]
+        self.reported.update(t.label[report].tolist())
+        due = report & held & ((t.label + self.frame) % p["pool_every"] == 0)
+        due &= dets[likely, 4] >= p["reid_confidence"] if n_meas else False
+        rows = np.flatnonzero(due)
+        if len(rows):
+            self.pool.add(self._embed(frame, dets[likely[rows], :4]), t.label[rows])
+
+    def _embed(self, frame: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+        return self.metric.embed(np.array([reid.lomo(c) for c in reid.crops(frame, boxes)]))
 
     def _association(self, gated: np.ndarray, log_q: np.ndarray) -> np.ndarray:
         """beta (tracks, measurements + 1) for every group; a track with no measurement in its gate is missed or
