@@ -14,7 +14,7 @@ import numpy as np
 DIM, MEAS = 8, 4
 # the model parameters the LMB and GM-PHD trackers share; noise values chosen on mot17_like seed 100 (not one
 # of the experiments' seeds 0..9)
-MODEL_DEFAULTS = {"survival": 0.98, "detection": 0.75, "clutter_rate": 5.0, "gate": 0.999,
+MODEL_DEFAULTS = {"survival": 0.98, "detection": 0.75, "clutter_rate": 5.0, "gate": 0.99,
                   "measurement_noise": 0.15, "process_noise": 0.01}
 F = np.eye(DIM) + np.eye(DIM, k=MEAS)
 H = np.eye(MEAS, DIM)

@@ -13,7 +13,7 @@ from .jpda import clusters
 from .particle import frame_of
 
 EPS = 1e-12
-ENUMERATE_UP_TO = 512  # groups with at most this many candidate hypotheses (an upper bound) are enumerated
+ENUMERATE_UP_TO = 4096  # groups with at most this many candidate hypotheses (an upper bound) are enumerated
 
 
 def factor_table(log_r: np.ndarray, log_q: np.ndarray, pd: float) -> np.ndarray:
@@ -120,7 +120,7 @@ class LabelledMultiBernoulli(Tracker):
 
     name = "lmb"
     description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
-    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 30,
+    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 15,
                 "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16, "fixed_birth_r": 0.03, "extract": 0.5,
                 "prune": 1e-3, "max_components": 4, "use_low_confidence": True, "low_confidence": 0.5, "reid": True, "reid_confidence": 0.7,
                 "reid_threshold": 5.0, "pool_per_target": 10, "pool_every": 10}
