@@ -258,7 +258,7 @@ class World:
             scale = self.depth_scale(self.pos[:, 1])[:, None]
             self.vel = body_vel / scale
             self._apply_motion()
-            out = self._carry(self.vel * scale)
+            out = self._carry(self.vel * scale) if "carried" in self._present_motions else self.vel * scale
             vel = data[:, 2:].copy()  # rows that are not targets (the static body) keep their own velocity
             vel[self._rows] = out[self._row_slot]
             buf = pbatch.Buffer()
@@ -268,7 +268,8 @@ class World:
         self.t += 1
         if len(self.ids):
             self.pos = self._slot_view(self._read_bodies())[:, :2]
-            self._pin_carried()
+            if "carried" in self._present_motions:
+                self._pin_carried()
         self._remove(self._leaving())
         self._spawn_births()
 

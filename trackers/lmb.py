@@ -63,15 +63,14 @@ class _Mixture:
     """Every track's Bernoulli (existence r, label) and Gaussian mixture components, sorted by track."""
 
     def __init__(self):
-        self.r, self.label, self.born = np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.r, self.label = np.zeros(0), np.zeros(0, np.int64)
         self.track, self.w = np.zeros(0, np.intp), np.zeros(0)
         self.m, self.P = np.zeros((0, gm.DIM)), np.zeros((0, gm.DIM, gm.DIM))
 
-    def add(self, r: np.ndarray, labels: np.ndarray, born: int, m: np.ndarray, P: np.ndarray) -> None:
+    def add(self, r: np.ndarray, labels: np.ndarray, m: np.ndarray, P: np.ndarray) -> None:
         """New tracks, one component each."""
         start = len(self.r)
         self.r, self.label = np.r_[self.r, r], np.r_[self.label, labels]
-        self.born = np.r_[self.born, np.full(len(r), born)]
         self.track = np.r_[self.track, start + np.arange(len(r))]
         self.w, self.m, self.P = np.r_[self.w, np.ones(len(r))], np.r_[self.m, m], np.concatenate([self.P, P])
 
@@ -90,7 +89,7 @@ class _Mixture:
         keep = (np.arange(len(track)) - first < max_components) & (w >= prune * total[track])
         track, w, m, P = track[keep], w[keep], m[keep], P[keep]
         w = w / np.bincount(track, w, minlength=len(keep_tracks))[track]
-        self.r, self.label, self.born = r[keep_tracks], self.label[keep_tracks], self.born[keep_tracks]
+        self.r, self.label = r[keep_tracks], self.label[keep_tracks]
         self.track, self.w, self.m, self.P = track, w, m, P
 
     def best(self) -> np.ndarray:
@@ -120,9 +119,9 @@ class LabelledMultiBernoulli(Tracker):
 
     name = "lmb"
     description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
-    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 15,
-                "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16, "fixed_birth_r": 0.03, "extract": 0.5,
-                "prune": 1e-3, "max_components": 4, "use_low_confidence": True, "low_confidence": 0.5, "reid": True, "reid_confidence": 0.7,
+    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 15, "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16,
+                "fixed_birth_r": 0.03, "extract": 0.5, "prune": 1e-3, "max_components": 4, "use_low_confidence": True,
+                "low_confidence": 0.5, "reid": True, "reid_confidence": 0.7,
                 "reid_threshold": 5.0, "pool_per_target": 10, "pool_every": 10}
 
     @property
@@ -143,7 +142,6 @@ class LabelledMultiBernoulli(Tracker):
         self.tracks = _Mixture()
         self.pending = (np.zeros((0, 4)), np.zeros(0))  # births for the next frame: boxes, r_B
         self.next_label, self.frame = 1, 0
-        self._beta = np.zeros((0, 1))
         self.metric = reid.Metric.shipped() if p["reid"] else None
         self.pool = None                      # made at the first frame, sized by its target count
         self.reported: set[int] = set()
@@ -163,7 +161,7 @@ class LabelledMultiBernoulli(Tracker):
         else:
             boxes, r = self.pending
             m, P = self.noise.birth(boxes)
-        t.add(r, self._labels(len(r)), self.frame, m, P)
+        t.add(r, self._labels(len(r)), m, P)
 
     def _fixed_birth_boxes(self, dets: np.ndarray) -> np.ndarray:
         """`fixed_births` boxes spread evenly around the image border, sized like this frame's median detection."""
@@ -201,7 +199,6 @@ class LabelledMultiBernoulli(Tracker):
                 log_q = safe + np.log(np.add.reduceat(np.exp(log_l - safe[t.track]), t.best(), axis=0))
         gated = np.isfinite(log_q)
         beta = self._association(gated, log_q - self.log_clutter_density)
-        self._beta = beta
         r_new = beta.sum(axis=1)
 
         # posterior mixtures: each component corrected by each measurement its track may have taken, plus missed
