@@ -115,6 +115,28 @@ def cmd_learn_reid(args) -> int:
     return 0
 
 
+def cmd_export(args) -> int:
+    from . import motchallenge
+    summary = motchallenge.export(args.scenario, args.out, args.seed, args.steps or None, parse_overrides(args.config))
+    for k, v in summary.items():
+        print(f"{k:12s} {v}")
+    return 0
+
+
+def cmd_eval(args) -> int:
+    from . import motchallenge
+    s = scenario.ScoringConfig()
+    metrics = motchallenge.evaluate_results(args.gt, args.results, similarity=args.similarity, threshold=args.threshold,
+                                            zero_distance=s.zero_distance, gospa_c=s.gospa_c, gospa_p=s.gospa_p)
+    summary = {k: metrics[k] for k in SUMMARY_KEYS}
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    for k, v in summary.items():
+        print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
+    return 0
+
+
 def cmd_config(args) -> int:
     if args.scenario:
         print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, parse_overrides(args.config))), indent=2))
@@ -169,6 +191,20 @@ def build_parser() -> argparse.ArgumentParser:
     lr.add_argument("--dims", type=int, default=16, help="XQDA subspace dimension")
     lr.add_argument("--out", default=None, help="where to write (default: the file the package ships)")
     lr.set_defaults(func=cmd_learn_reid)
+    ex = sub.add_parser("export", help="write an episode as a MOTChallenge sequence (frames, gt, detections)")
+    ex.add_argument("scenario")
+    ex.add_argument("--out", required=True, help="the sequence folder to write")
+    ex.add_argument("--seed", type=int, default=0)
+    ex.add_argument("--steps", type=int, default=0, help="at most this many frames (default: env.max_steps)")
+    ex.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE")
+    ex.set_defaults(func=cmd_export)
+    ev = sub.add_parser("eval", help="score a MOTChallenge results file against an exported sequence")
+    ev.add_argument("--gt", required=True, help="the sequence folder (with seqinfo.ini and gt/gt.txt)")
+    ev.add_argument("--results", required=True, help="frame, id, x, y, w, h, ... per line")
+    ev.add_argument("--similarity", choices=("iou", "centroid"), default="iou")
+    ev.add_argument("--threshold", type=float, default=0.5)
+    ev.add_argument("--json", action="store_true")
+    ev.set_defaults(func=cmd_eval)
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
     cf.add_argument("scenario", nargs="?")
     cf.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE")

@@ -8,5 +8,6 @@
 
 from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, lmb, particle, sort  # noqa: F401  (each registers its tracker)
 from .base import Tracker, Tracks, available, make, parse_spec, register
+from .external import External
 
-__all__ = ["Tracker", "Tracks", "available", "make", "parse_spec", "register"]
+__all__ = ["External", "Tracker", "Tracks", "available", "make", "parse_spec", "register"]

@@ -1,0 +1,120 @@
+"""MOTChallenge interchange: write an episode as a MOT17-style sequence, read results files back and score them.
+
+A sequence folder holds `seqinfo.ini`, `img1/000001.jpg ...`, `gt/gt.txt` and `det/det.txt`, all with 1-based
+frame numbers. Rows are comma-separated:
+- gt: frame, id, x, y, w, h, considered (1, or 0 for a target the scenario's scoring leaves out), class 1,
+  visibility;
+- det: frame, -1, x, y, w, h, confidence, -1, -1, -1;
+- results (what a tracker writes): frame, id, x, y, w, h, and anything after (ignored).
+Boxes are the env's pixel coordinates (top-left corner, width, height) as they are: gt, det and results share
+them, so any tool that compares the files sees the same geometry the env scores.
+"""
+
+from __future__ import annotations
+
+import configparser
+from pathlib import Path
+from typing import Mapping
+
+import cv2
+import numpy as np
+
+from .env import TrackingEnv
+from .metrics import evaluate
+
+NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}
+
+
+def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
+           config: Mapping | None = None) -> dict:
+    """Run `scenario` without a tracker and write its frames, ground truth and detections as a sequence."""
+    out = Path(out)
+    (out / "img1").mkdir(parents=True, exist_ok=True)
+    (out / "gt").mkdir(exist_ok=True)
+    (out / "det").mkdir(exist_ok=True)
+    env = TrackingEnv(scenario, config=config, obs_mode="frame+detections")
+    obs, _ = env.reset(seed=seed)
+    sc = env.scenario
+    limit = steps or sc.env.max_steps
+    gt_rows, det_rows = [], []
+    frame = 0
+    while True:
+        frame += 1
+        cv2.imwrite(str(out / "img1" / f"{frame:06d}.jpg"), cv2.cvtColor(obs["frame"], cv2.COLOR_RGB2BGR),
+                    [cv2.IMWRITE_JPEG_QUALITY, 95])
+        t = env.truth
+        considered = t.visibility >= sc.scoring.min_visibility
+        gt_rows += [(frame, int(i), *b, int(c), 1, float(v))
+                    for i, b, c, v in zip(t.ids, t.boxes.tolist(), considered, t.visibility)]
+        dets = obs["detections"][: int(obs["num_detections"])]
+        det_rows += [(frame, -1, *d[:4], d[4], -1, -1, -1) for d in dets.tolist()]
+        obs, _, terminated, truncated, _ = env.step(NO_TRACKS)
+        if terminated or truncated or frame >= limit:
+            break
+    _write_rows(out / "gt" / "gt.txt", gt_rows)
+    _write_rows(out / "det" / "det.txt", det_rows)
+    info = configparser.ConfigParser()
+    info.optionxform = str
+    info["Sequence"] = {"name": f"{sc.name}-seed{seed}", "imDir": "img1", "frameRate": "30", "seqLength": str(frame),
+                        "imWidth": str(sc.render.width), "imHeight": str(sc.render.height), "imExt": ".jpg"}
+    with (out / "seqinfo.ini").open("w") as f:
+        info.write(f, space_around_delimiters=False)
+    return {"frames": frame, "gt_rows": len(gt_rows), "det_rows": len(det_rows), "folder": str(out)}
+
+
+def _write_rows(path: Path, rows) -> None:
+    """Comma-separated rows; floats with 9 significant digits, enough to give back a float32 box exactly."""
+    path.write_text("".join(",".join(f"{v:.9g}" if isinstance(v, float) else str(v) for v in r) + "\n" for r in rows))
+
+
+def sequence_length(folder: str | Path) -> int:
+    info = configparser.ConfigParser()
+    if not info.read(Path(folder) / "seqinfo.ini"):
+        raise FileNotFoundError(f"{Path(folder) / 'seqinfo.ini'}: not found; is {folder} a MOTChallenge sequence?")
+    return int(info["Sequence"]["seqLength"])
+
+
+def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
+    """A MOTChallenge text file as a float array (rows, columns), with a clear error for a malformed one."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: not found")
+    text = path.read_text().strip()
+    if not text:
+        return np.zeros((0, min_columns))
+    try:
+        rows = np.array([[float(v) for v in line.replace(" ", "").split(",")] for line in text.splitlines()])
+    except ValueError as err:
+        raise ValueError(f"{path}: not a comma-separated MOTChallenge file ({err})") from None
+    if rows.ndim != 2 or rows.shape[1] < min_columns:
+        raise ValueError(f"{path}: every row needs at least {min_columns} comma-separated values "
+                         "(frame, id, x, y, w, h, ...)")
+    if not np.isfinite(rows[:, :6]).all():
+        raise ValueError(f"{path}: row {int(np.flatnonzero(~np.isfinite(rows[:, :6]).all(1))[0]) + 1} is not finite")
+    return rows
+
+
+def per_frame(rows: np.ndarray, frames: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(ids, boxes) for frames 1..frames from rows (frame, id, x, y, w, h, ...)."""
+    frame = rows[:, 0].astype(int)
+    order = np.argsort(frame, kind="stable")
+    rows, frame = rows[order], frame[order]
+    bounds = np.searchsorted(frame, np.arange(1, frames + 2))
+    return [(rows[a:b, 1].astype(np.int64), rows[a:b, 2:6]) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def evaluate_results(gt_folder: str | Path, results: str | Path, **scoring) -> dict:
+    """Our metrics of a results file against a sequence's ground truth (its considered rows)."""
+    frames = sequence_length(gt_folder)
+    gt = read_rows(Path(gt_folder) / "gt" / "gt.txt", 7)
+    res = read_rows(results, 6)
+    late = res[:, 0] > frames
+    if late.any() or (res[:, 0] < 1).any():
+        raise ValueError(f"{results}: frame numbers must lie in 1..{frames} (the sequence's length)")
+    return evaluate(per_frame(gt[gt[:, 6] > 0], frames), per_frame(res, frames), **scoring)
+
+
+def write_results(path: str | Path, tracks_per_frame) -> None:
+    """A results file from per-frame (ids, boxes): frame, id, x, y, w, h, 1, -1, -1, -1."""
+    _write_rows(Path(path), [(f, int(i), *b, 1, -1, -1, -1) for f, (ids, boxes) in enumerate(tracks_per_frame, 1)
+                             for i, b in zip(ids, np.asarray(boxes, float).tolist())])

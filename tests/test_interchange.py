@@ -1,0 +1,114 @@
+"""MOTChallenge export and evaluation round trips, and third-party trackers in the Gym loop."""
+
+import cv2
+import numpy as np
+import pytest
+
+import trackers
+from mtt_sim import cli, motchallenge
+from mtt_sim.env import TrackingEnv
+
+STEPS = 40
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("seq")
+    summary = motchallenge.export("mot17_like", folder, seed=0, steps=STEPS)
+    return folder, summary
+
+
+def in_process(spec):
+    """`spec` on mot17_like seed 0 in the env: (per-frame tracks, detections, the env's metrics)."""
+    env = TrackingEnv("mot17_like", config={"env.max_steps": STEPS})
+    obs, info = env.reset(seed=0)
+    tracker = trackers.make(spec) if isinstance(spec, str) else spec
+    tracker.reset(info)
+    tracks, dets = [], []
+    while True:
+        dets.append(obs["detections"][: int(obs["num_detections"])].copy())
+        t = tracker.update(obs)
+        tracks.append((t.ids, t.boxes))
+        obs, _, term, trunc, info = env.step(t.to_action(env.action_space))
+        if term or trunc:
+            return tracks, dets, info["metrics"]
+
+
+def test_export_writes_a_mot17_sequence(sequence):
+    folder, summary = sequence
+    assert summary["frames"] == motchallenge.sequence_length(folder) == STEPS
+    img = cv2.imread(str(folder / "img1" / f"{STEPS:06d}.jpg"))
+    assert img.shape == (540, 960, 3) and not (folder / "img1" / f"{STEPS + 1:06d}.jpg").exists()
+    gt = motchallenge.read_rows(folder / "gt" / "gt.txt", 9)
+    assert gt.shape == (summary["gt_rows"], 9) and set(gt[:, 7]) == {1} and (gt[:, 8] <= 1).all()
+    _, dets, _ = in_process("echo")           # the same detections as a run without frames
+    det = motchallenge.read_rows(folder / "det" / "det.txt", 10)
+    np.testing.assert_allclose(det[:, 2:7], np.concatenate(dets), rtol=1e-7)
+
+
+def test_ground_truth_as_results_scores_perfectly(sequence, capsys):
+    folder, _ = sequence
+    gt = motchallenge.read_rows(folder / "gt" / "gt.txt", 9)
+    results = folder / "perfect.txt"
+    motchallenge.write_results(results, motchallenge.per_frame(gt, STEPS))
+    assert cli.main(["eval", "--gt", str(folder), "--results", str(results), "--json"]) == 0
+    out = capsys.readouterr().out
+    for key in ('"MOTA": 1.0', '"IDF1": 1.0', '"HOTA": 1.0', '"IDSW": 0', '"FP": 0', '"FN": 0'):
+        assert key in out
+
+
+def test_our_tracker_written_to_a_results_file_scores_as_in_process(sequence, tmp_path):
+    folder, _ = sequence
+    tracks, _, expected = in_process("sort")
+    results = tmp_path / "sort.txt"
+    motchallenge.write_results(results, tracks)
+    got = motchallenge.evaluate_results(folder, results)
+    assert {k: got[k] for k in ("TP", "FP", "FN", "IDSW", "IDTP", "MT", "num_gt_dets")} == \
+        {k: expected[k] for k in ("TP", "FP", "FN", "IDSW", "IDTP", "MT", "num_gt_dets")}
+    for key in ("MOTA", "MOTP", "IDF1", "HOTA", "GOSPA", "CentreError"):
+        assert got[key] == pytest.approx(expected[key], rel=1e-6), key
+
+
+def test_bad_results_files_get_clear_errors(sequence, tmp_path):
+    folder, _ = sequence
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1,2,3\n")
+    with pytest.raises(ValueError, match=r"at least 6 comma-separated values \(frame, id, x, y, w, h"):
+        motchallenge.evaluate_results(folder, bad)
+    bad.write_text(f"{STEPS + 1},1,0,0,10,10\n")
+    with pytest.raises(ValueError, match=rf"frame numbers must lie in 1..{STEPS}"):
+        motchallenge.evaluate_results(folder, bad)
+    bad.write_text("1,1,nan,0,10,10\n")
+    with pytest.raises(ValueError, match="row 1 is not finite"):
+        motchallenge.evaluate_results(folder, bad)
+    with pytest.raises(FileNotFoundError, match="seqinfo.ini"):
+        motchallenge.evaluate_results(tmp_path, bad)
+
+
+class SortReferenceStyle:
+    """A third-party tracker with the SORT reference code's interface: update(x1, y1, x2, y2, score) rows ->
+    (x1, y1, x2, y2, id) rows. Here it runs our SORT underneath, so the result is known."""
+
+    def __init__(self):
+        self.inner = trackers.make("sort")
+        self.inner.reset({})
+
+    def update(self, dets):
+        boxes = dets.copy()
+        boxes[:, 2:4] -= boxes[:, :2]
+        padded = np.zeros((max(len(boxes), 1), 5), np.float32)
+        padded[: len(boxes)] = boxes
+        t = self.inner.update({"detections": padded, "num_detections": len(boxes)})
+        return np.c_[t.boxes[:, :2], t.boxes[:, :2] + t.boxes[:, 2:], t.ids]
+
+
+def test_external_adapter_runs_a_third_party_tracker_in_the_gym_loop():
+    _, _, ours = in_process("sort")
+    _, _, theirs = in_process(trackers.External(factory=SortReferenceStyle, box_format="xyxy"))
+    assert theirs.keys() == ours.keys()
+    for key, value in ours.items():   # counts exactly; float32 boxes through x1, y1, x2, y2 and back: rounding only
+        assert theirs[key] == (value if isinstance(value, int) else pytest.approx(value, rel=1e-6)), key
+    with pytest.raises(ValueError, match="box_format='tlbr': allowed values: 'xywh', 'xyxy'"):
+        trackers.External(SortReferenceStyle(), box_format="tlbr")
+    with pytest.raises(TypeError, match="has no update"):
+        trackers.External(object()).reset({})
