@@ -57,7 +57,8 @@ def _grid_output(args, records, tables):
 
 def cmd_bench(args) -> int:
     records = experiment.run_grid(args.trackers.split(","), args.scenarios.split(","), args.seeds,
-                                  config=parse_overrides(args.config), workers=args.workers, progress=True)
+                                  config=parse_overrides(args.config), workers=args.workers, progress=True,
+                                  backend=args.backend, address=args.address)
     title = args.scenarios if args.by == "target" else ""
     _grid_output(args, records, [experiment.markdown(experiment.summarize(records, m, by=args.by), title)
                                  for m in args.metric.split(",")])
@@ -71,7 +72,7 @@ def cmd_sweep(args) -> int:
     values = [_toml_value(v) for v in values.split(",")]
     records = experiment.run_grid(args.trackers.split(","), [args.scenario], args.seeds,
                                   config=parse_overrides(args.config), configs=[{key: v} for v in values],
-                                  workers=args.workers, progress=True)
+                                  workers=args.workers, progress=True, backend=args.backend, address=args.address)
     tables = []
     for metric in args.metric.split(","):
         rows = experiment.summarize(records, metric, by="config")
@@ -172,7 +173,11 @@ def build_parser() -> argparse.ArgumentParser:
             g.add_argument("--plot", help="write the curve as a PNG (needs the [plot] extra: matplotlib)")
         g.add_argument("--trackers", required=True, help="comma-separated tracker specs, e.g. sort,iou,'gnn:coast=true'")
         g.add_argument("--seeds", type=int, default=5, help="seeds 0..N-1 (default 5)")
-        g.add_argument("--workers", type=int, default=1, help="parallel processes (default 1)")
+        g.add_argument("--workers", type=int, default=1, help="parallel processes, or a local Ray instance's CPUs "
+                                                               "(default 1)")
+        g.add_argument("--backend", choices=experiment.BACKENDS, default="local",
+                       help="local processes, or Ray tasks (the [ray] extra)")
+        g.add_argument("--address", help="with --backend ray: a Ray cluster's address (default: start a local one)")
         g.add_argument("--metric", default="MOTA", help="metric(s) of the tables, comma-separated (default MOTA)")
         g.add_argument("--out", help="write every episode's record (.csv, or .json)")
         g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")

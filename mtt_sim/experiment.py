@@ -64,16 +64,25 @@ def _task(args):
     return run_episode(*args)
 
 
+BACKENDS = ("local", "ray")
+
+
 def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequence[int] | int,
              config: Mapping | None = None, configs: Sequence[Mapping] | None = None, workers: int = 1,
-             progress: bool = False) -> list[dict]:
-    """Every tracker x scenario x seed (x config, for sweeps), in `workers` processes; records in grid order."""
+             progress: bool = False, backend: str = "local", address: str | None = None) -> list[dict]:
+    """Every tracker x scenario x seed (x config, for sweeps); records in grid order. backend="local" runs them in
+    `workers` processes; "ray" as Ray tasks, on a local Ray instance of `workers` CPUs or on the cluster at
+    `address` (the [ray] extra)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend={backend!r}: allowed values: {', '.join(map(repr, BACKENDS))}")
     seeds = range(seeds) if isinstance(seeds, int) else seeds
     for spec in tracker_specs:
         trackers.make(spec)  # fail fast on a bad spec, before any process starts
     tasks = [(sc, spec, seed, {**(config or {}), **c}) for c, sc, spec, seed in
              itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
     bar = _Progress(len(tasks)) if progress else None
+    if backend == "ray":
+        return _run_on_ray(tasks, workers, address, bar)
     if workers <= 1:
         records = []
         for t in tasks:
@@ -87,6 +96,31 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
             records[futures[done]] = done.result()
             bar and bar.step(tasks[futures[done]])
     return records
+
+
+def _run_on_ray(tasks: list, workers: int, address: str | None, bar) -> list[dict]:
+    """The episodes as Ray tasks, collected as they finish; a Ray instance started here is shut down after."""
+    try:
+        import ray
+    except ImportError:
+        raise ImportError("backend 'ray' needs Ray: pip install 'mtt-sim[ray]'") from None
+    started = not ray.is_initialized()
+    if started:
+        ray.init(address=address, num_cpus=None if address else max(1, workers), include_dashboard=False,
+                 log_to_driver=False, configure_logging=False)
+    try:
+        remote = ray.remote(_task)
+        index = {remote.remote(t): i for i, t in enumerate(tasks)}
+        records, pending = [None] * len(tasks), list(index)
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            i = index[done[0]]
+            records[i] = ray.get(done[0])
+            bar and bar.step(tasks[i])
+        return records
+    finally:
+        if started:
+            ray.shutdown()
 
 
 class _Progress:

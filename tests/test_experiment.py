@@ -23,6 +23,18 @@ def test_parallel_grid_equals_serial_and_is_in_grid_order():
     assert serial[2]["params"]["coast"] is True and all(r["tracker_fps"] > 0 for r in serial)
 
 
+def test_ray_backend_gives_the_records_of_the_local_backend(capsys):
+    pytest.importorskip("ray", reason="the ray backend needs the [ray] extra (CI installs it)")
+    args = (["sort", "lmb:reid=false"], ["clutter_storm"], 2)
+    cfg = {"env.max_steps": 10}
+    local = experiment.run_grid(*args, config=cfg, workers=1)
+    on_ray = experiment.run_grid(*args, config=cfg, workers=2, backend="ray", progress=True)
+    assert strip_speed(on_ray) == strip_speed(local)
+    assert "4/4" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="backend='spark': allowed values: 'local', 'ray'"):
+        experiment.run_grid(*args, backend="spark")
+
+
 def test_bad_tracker_spec_fails_before_any_work():
     with pytest.raises(ValueError, match="unknown tracker 'nope'"):
         experiment.run_grid(["sort", "nope"], ["crossing"], 1)
