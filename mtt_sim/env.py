@@ -28,6 +28,8 @@ from .world import World
 _SPACE_KEYS = ("render.width", "render.height", "sensor.max_detections", "env.max_tracks", "env.obs_mode")
 _TRAIL = 12
 
+NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}  # the action that reports nothing
+
 
 class ActionError(ValueError):
     """The agent's action does not describe a valid set of tracks."""

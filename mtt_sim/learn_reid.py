@@ -13,10 +13,7 @@ import numpy as np
 
 from trackers import reid
 
-from .env import TrackingEnv
-
-NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}
-
+from .env import NO_TRACKS, TrackingEnv
 
 def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility: float = 0.9,
                    min_height: float = 24.0) -> tuple[np.ndarray, np.ndarray]:

@@ -19,11 +19,8 @@ from typing import Mapping
 import cv2
 import numpy as np
 
-from .env import TrackingEnv
+from .env import NO_TRACKS, TrackingEnv
 from .metrics import evaluate
-
-NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}
-
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
            config: Mapping | None = None) -> dict:

@@ -16,7 +16,7 @@ from scipy.optimize import linear_sum_assignment
 
 import trackers
 
-from .env import TrackingEnv
+from .env import NO_TRACKS, TrackingEnv
 from .metrics import EpisodeMetrics, box_iou
 
 SIZE = (640, 480)
@@ -29,10 +29,9 @@ def _env(n: int, obs_mode: str) -> TrackingEnv:
 
 def _steps_per_second(env: TrackingEnv, steps: int) -> float:
     env.reset(seed=0)
-    empty = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4), np.float32)}
     start = time.perf_counter()
     for _ in range(steps):
-        env.step(empty)
+        env.step(NO_TRACKS)
     return steps / (time.perf_counter() - start)
 
 
@@ -128,15 +127,8 @@ def report_metrics(rows: list[dict]) -> str:
 
 def _recorded_detections(n: int, frames: int, clutter: float = 5.0, with_frames: bool = False):
     """env.reset's info and the observations of `n` targets with P_D = 0.9 and Poisson clutter, recorded once."""
-    env = TrackingEnv("clutter_storm", config={"groups.0.count": n, "sensor.pd": 0.9, "sensor.clutter_rate": clutter,
-                                               "sensor.min_visibility": 0.0, "env.max_steps": frames},
-                      obs_mode="frame+detections" if with_frames else "detections")
-    obs, info = env.reset(seed=0)
-    out = []
-    for _ in range(frames):
-        out.append({k: v.copy() if hasattr(v, "copy") else v for k, v in obs.items()})
-        obs = env.step({"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))})[0]
-    return info, out
+    config = {"groups.0.count": n, "sensor.pd": 0.9, "sensor.clutter_rate": clutter, "sensor.min_visibility": 0.0}
+    return _recorded("clutter_storm", frames, config, "frame+detections" if with_frames else "detections")
 
 
 def _ms_per_frame(spec: str, recorded: tuple[dict, list[dict]]) -> float:
@@ -187,14 +179,15 @@ def report_lmb(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
-def _recorded(scenario: str, frames: int) -> tuple[dict, list]:
+def _recorded(scenario: str, frames: int, config: dict | None = None,
+              obs_mode: str = "frame+detections") -> tuple[dict, list[dict]]:
     """env.reset's info and `frames` observations of `scenario` (seed 0, no tracks), for timing trackers alone."""
-    env = TrackingEnv(scenario, config={"env.max_steps": frames})
+    env = TrackingEnv(scenario, config={**(config or {}), "env.max_steps": frames}, obs_mode=obs_mode)
     obs, info = env.reset(seed=0)
     recorded = []
     for _ in range(frames):
-        recorded.append(obs)
-        obs = env.step({"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))})[0]
+        recorded.append({k: v.copy() if hasattr(v, "copy") else v for k, v in obs.items()})
+        obs = env.step(NO_TRACKS)[0]
     return info, recorded
 
 

@@ -246,30 +246,22 @@ class LabelledMultiBernoulli(Tracker):
         return self.metric.embed(np.array([reid.lomo(c) for c in reid.crops(frame, boxes)]))
 
     def _association(self, gated: np.ndarray, log_q: np.ndarray) -> np.ndarray:
-        """beta (tracks, measurements + 1) for every group; a track with no measurement in its gate is missed or
-        gone in closed form."""
+        """beta (tracks, measurements + 1) for every group. Every track alone in its group (with no measurement in
+        its gate, or none another track shares) and with few options gets all its hypotheses in closed form, all
+        such tracks at once; the other groups go through `group_update`."""
         p, t = self.params, self.tracks
         n, m = gated.shape
         beta = np.zeros((n, m + 1))
-        pd = p["detection"]
-        lonely = ~gated.any(axis=1)
-        beta[lonely, m] = t.r[lonely] * (1 - pd) / (1 - t.r[lonely] * pd)
-        busy = np.flatnonzero(~lonely)
-        if not len(busy):
+        if not n:
             return beta
-        used = np.flatnonzero(gated[busy].any(axis=0))
-        track_group, meas_group = clusters(gated[np.ix_(busy, used)])
-        log_r = np.log(np.maximum(t.r, EPS))
-        # a track alone in its group with few options: all its hypotheses at once, for every such track
-        alone = np.bincount(track_group)[track_group] == 1
-        alone &= gated[busy].sum(axis=1) + 2 <= p["hypotheses"]
-        rows = busy[alone]
-        table = factor_table(log_r[rows], log_q[rows], pd)
+        pd, log_r = p["detection"], np.log(np.maximum(t.r, EPS))
+        track_group, meas_group = clusters(gated)
+        alone = (np.bincount(track_group)[track_group] == 1) & (gated.sum(axis=1) + 2 <= p["hypotheses"])
+        table = factor_table(log_r[alone], log_q[alone], pd)
         w = np.exp(table - table.max(axis=1, keepdims=True))
-        beta[rows] = (w / w.sum(axis=1, keepdims=True))[:, :-1]
+        beta[alone] = (w / w.sum(axis=1, keepdims=True))[:, :-1]
         for g in np.unique(track_group[~alone]):
-            rows = busy[track_group == g]
-            cols = used[meas_group == g]
+            rows, cols = np.flatnonzero(track_group == g), np.flatnonzero(meas_group == g)
             b = group_update(log_r[rows], log_q[np.ix_(rows, cols)], pd, p["hypotheses"])
             beta[np.ix_(rows, cols)] = b[:, :-1]
             beta[rows, m] = b[:, -1]
