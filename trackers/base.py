@@ -67,6 +67,14 @@ def detections(obs: Mapping) -> np.ndarray:
     return rows
 
 
+def frame_of(obs) -> np.ndarray:
+    """The observation's video frame, or a clear error for a detections-only env."""
+    frame = obs.get("frame") if hasattr(obs, "get") else None
+    if frame is None or np.ndim(frame) != 3 or np.size(frame) == 0:
+        raise ValueError("this tracker reads the video frame: make the env with obs_mode='frame+detections'")
+    return np.asarray(frame)
+
+
 class Tracker:
     """Base class: subclasses set `name`, `description`, `defaults` and implement `reset` and `update`."""
 

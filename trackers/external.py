@@ -6,8 +6,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .base import Tracker, Tracks, detections
-from .particle import frame_of
+from .base import Tracker, Tracks, detections, frame_of
 
 FORMATS = ("xywh", "xyxy")
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import bhattacharyya, histograms, hs_bins
-from .base import Tracker, Tracks, register
-from .particle import crop_around, frame_of, initial_targets
+from .base import Tracker, Tracks, frame_of, register
+from .particle import crop_around, initial_targets
 
 
 def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.ndarray:

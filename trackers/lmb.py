@@ -8,9 +8,8 @@ import numpy as np
 from . import gaussian_mixture as gm
 from . import reid
 from .assignment import chi2_gate, murty
-from .base import Tracker, Tracks, covariance_ellipse, detections, register
+from .base import Tracker, Tracks, covariance_ellipse, detections, frame_of, register
 from .jpda import clusters
-from .particle import frame_of
 
 EPS = 1e-12
 ENUMERATE_UP_TO = 4096  # groups with at most this many candidate hypotheses (an upper bound) are enumerated

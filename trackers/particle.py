@@ -6,15 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import bhattacharyya, gradient_descriptors, histograms, orientation_maps, rgb_bins
-from .base import Tracker, Tracks, register
-
-
-def frame_of(obs) -> np.ndarray:
-    """The observation's video frame, or a clear error for a detections-only env."""
-    frame = obs.get("frame") if hasattr(obs, "get") else None
-    if frame is None or np.ndim(frame) != 3 or np.size(frame) == 0:
-        raise ValueError("this tracker reads the video frame: make the env with obs_mode='frame+detections'")
-    return np.asarray(frame)
+from .base import Tracker, Tracks, frame_of, register
 
 
 def initial_targets(info) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
