@@ -17,6 +17,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
+
 
 class ConfigError(ValueError):
     """A scenario file or override is invalid; the message names file, key, value and what is allowed."""
@@ -102,7 +104,8 @@ class WorldConfig:
     size: tuple[float, float] = spec((0.0, 0.0), "world width, height; 0 = the image size (larger for a panning camera)", "px", 0.0, 1e5)
     walls: bool = spec(False, "targets bounce off the world borders instead of leaving")
     collision: str = spec("elastic", "target-target contacts: elastic, soft (inelastic) or none", choices=("elastic", "soft", "none"))
-    max_alive: int = spec(1000, "no births while this many targets are alive", "targets", 1, 100000)
+    max_alive: int = spec(1000, "no births while this many targets are alive (at most the label map's 65535)", "targets", 1,
+                          65535)
     max_births: int = spec(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
     far_scale: float = spec(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
 
@@ -233,6 +236,8 @@ def _convert(value, tp, key: str, meta: Mapping, where: str):
     def fail(allowed: str):
         raise ConfigError(f"{where}: {key} = {value!r}: {allowed}")
 
+    if isinstance(value, (np.generic, np.ndarray)):  # numpy numbers and arrays are numbers and lists
+        value = value.tolist()
     origin = typing.get_origin(tp)
     if dataclasses.is_dataclass(tp):
         if not isinstance(value, Mapping):
@@ -255,7 +260,7 @@ def _convert(value, tp, key: str, meta: Mapping, where: str):
         if isinstance(value, bool) or not isinstance(value, int):
             fail("expected an integer" + _range_text(meta))
     elif tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_as_float(value)):
             fail("expected a finite number" + _range_text(meta))
         value = float(value)
     elif tp is str:
@@ -267,6 +272,14 @@ def _convert(value, tp, key: str, meta: Mapping, where: str):
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         fail("out of range;" + _range_text(meta))
     return value
+
+
+def _as_float(value: int | float) -> float:
+    """float(value), with an integer too large for a float read as infinite (so it fails as not finite)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
 
 
 def _range_text(meta: Mapping) -> str:
@@ -343,6 +356,38 @@ def _check_references(sc: Scenario, where: str) -> Scenario:
     if sc.sensor.model == "foreground" and sc.render.camera in ("pan", "follow"):
         raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = "
                           f"{sc.render.camera!r}")
+    return _check_budget(sc, where)
+
+
+LABEL_MAX = 65535  # the uint16 label map holds slot + 1 of every target alive
+MEMORY_BUDGET = 4 * 2**30  # bytes; a scenario estimated to need more is refused before anything is allocated
+
+
+def memory_estimate(sc: Scenario) -> int:
+    """Bytes an episode of `sc` needs at its peak, roughly: the world backdrop (about 100 bytes a pixel while its
+    noise is made in float64, 3 once done), each image pixel's frame, label map, noise bank and detector model
+    (40 bytes), and each target's arrays and pymunk body (2 KB)."""
+    ww, wh = sc.world_size
+    margin = 8 * sc.render.shake if sc.render.camera == "shake" else 0.0
+    world_px = (ww + margin) * (wh + margin)
+    image_px = sc.render.width * sc.render.height
+    per_world_px = 3 if sc.render.background == "flat" else 100
+    return int(world_px * per_world_px + image_px * 40 + sum(g.count for g in sc.groups) * 2048)
+
+
+def _check_budget(sc: Scenario, where: str) -> Scenario:
+    """Totals no single field's range bounds: targets against the label map's range, the memory an episode needs."""
+    total = sum(g.count for g in sc.groups)
+    if total > LABEL_MAX:
+        counts = " + ".join(str(g.count) for g in sc.groups)
+        raise ConfigError(f"{where}: groups[].count: {counts} = {total} targets at reset; at most {LABEL_MAX} can be "
+                          "alive at once (the uint16 label map's range)")
+    need = memory_estimate(sc)
+    if need > MEMORY_BUDGET:
+        ww, wh = sc.world_size
+        raise ConfigError(f"{where}: this scenario would need about {need / 2**30:.1f} GiB (world.size {ww:g} x {wh:g} "
+                          f"px, image {sc.render.width} x {sc.render.height} px, {total} targets); the budget is "
+                          f"{MEMORY_BUDGET / 2**30:.0f} GiB: make the world or the image smaller")
     return sc
 
 
@@ -391,39 +436,64 @@ def load_raw(key_or_path: str | Path) -> tuple[dict, str]:
         raise ConfigError(f"{where}: invalid TOML: {err}") from None
 
 
-def expand_dotted(overrides: Mapping) -> dict:
-    """Turn {"sensor.pd": 0.5} and nested dicts alike into one nested dict."""
+def expand_dotted(overrides: Mapping, prefix: str = "") -> dict:
+    """Turn {"sensor.pd": 0.5} and nested dicts alike, or any mix of the two, into one nested dict.
+
+    Integer keys are list indices ({"groups": {0: {...}}} is "groups.0..."). A value given twice (say as
+    "sensor.pd" and inside "sensor") is an error, never silently dropped.
+    """
+    if not isinstance(overrides, Mapping):
+        raise ConfigError(f"config overrides must be a mapping of keys to values, got {type(overrides).__name__}")
     out: dict = {}
     for key, value in overrides.items():
-        if not isinstance(key, str):
-            raise ConfigError(f"override keys must be strings, got {key!r}")
+        if isinstance(key, int) and not isinstance(key, bool):
+            key = str(key)
+        if not isinstance(key, str) or not key or "" in key.split("."):
+            raise ConfigError(f"override key {prefix}{key!r}: keys are dotted names such as 'sensor.pd'")
+        node, path = out, prefix
         *parents, leaf = key.split(".")
-        node = out
-        for p in parents:
-            node = node.setdefault(p, {})
+        for part in parents:
+            path += part + "."
+            node = node.setdefault(part, {})
             if not isinstance(node, dict):
-                raise ConfigError(f"override {key!r} conflicts with a non-table value at {p!r}")
-        node[leaf] = expand_dotted(value) if isinstance(value, Mapping) else value
+                raise ConfigError(f"override {path.rstrip('.')} is given both as a value and as a table of keys")
+        if isinstance(value, Mapping):
+            value = expand_dotted(value, f"{path}{leaf}.")
+        _put(node, leaf, value, path)
     return out
+
+
+def _put(node: dict, key: str, value, prefix: str) -> None:
+    """node[key] = value, merging tables and refusing a second value for the same key."""
+    if key not in node:
+        node[key] = value
+    elif isinstance(node[key], dict) and isinstance(value, dict):
+        for k, v in value.items():
+            _put(node[key], k, v, f"{prefix}{key}.")
+    else:
+        raise ConfigError(f"override {prefix}{key} is given twice (e.g. as a dotted key and inside a table); give it once")
 
 
 def merge(base: Mapping, overrides: Mapping, prefix: str = "") -> dict:
-    """Recursively merge `overrides` into `base`; list items are addressed by index ("groups.0.count")."""
-    out: Any = dict(base)
+    """Recursively merge `overrides` into `base`; list items are addressed by index ("groups.0.count",
+    "groups.0.size.0")."""
+    out = dict(base)
     for key, value in overrides.items():
-        current = out.get(key)
-        if isinstance(current, list) and isinstance(value, Mapping):
-            items = [dict(x) for x in current]
-            for idx, sub in value.items():
-                if not (isinstance(idx, str) and idx.isdigit() and int(idx) < len(items)):
-                    raise ConfigError(f"override {prefix}{key}.{idx}: no such item; {prefix}{key} has {len(items)} entries")
-                items[int(idx)] = merge(items[int(idx)], sub, f"{prefix}{key}.{idx}.")
-            out[key] = items
-        elif isinstance(current, Mapping) and isinstance(value, Mapping):
-            out[key] = merge(current, value, f"{prefix}{key}.")
-        else:
-            out[key] = value
+        out[key] = _merged(out.get(key), value, f"{prefix}{key}")
     return out
+
+
+def _merged(current, value, path: str):
+    if isinstance(current, Mapping) and isinstance(value, Mapping):
+        return merge(current, value, path + ".")
+    if isinstance(current, (list, tuple)) and isinstance(value, Mapping):
+        items = list(current)
+        for idx, sub in value.items():
+            if not (isinstance(idx, str) and idx.isdigit() and int(idx) < len(items)):
+                raise ConfigError(f"override {path}.{idx}: no such item; {path} has {len(items)} entries")
+            items[int(idx)] = _merged(items[int(idx)], sub, f"{path}.{idx}")
+        return items
+    return value
 
 
 def to_mapping(obj) -> Any:
@@ -475,6 +545,9 @@ def reference_table() -> str:
             rows.append(f"| `{prefix}{f.name}` | `{default!r}` | {meta.get('unit', '')} | {allowed} | {meta.get('doc', '')} |")
 
     walk(Scenario, "")
+    rows += ["", f"Totals: at most {LABEL_MAX} targets at reset (the sum of `groups[].count`, the uint16 label map's "
+                 f"range), and an estimated peak memory (`mtt_sim.scenario.memory_estimate`) of at most "
+                 f"{MEMORY_BUDGET // 2**30} GiB, which bounds `world.size` times the image size."]
     return "\n".join(rows)
 
 

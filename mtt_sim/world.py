@@ -60,6 +60,7 @@ class World:
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
             setattr(self, name, np.zeros((0, width) if width else 0, dtype))
         self.bodies: list[pymunk.Body] = []
+        self._pending: list[dict] = []  # rows of targets spawned but not yet in the state arrays
         g = scenario.groups
         self._motion = np.array([MOTIONS.index(x.motion) for x in g])
         self._present_motions = {x.motion for x in g}
@@ -132,11 +133,13 @@ class World:
         self.space.add(*shapes)
 
     def _populate(self):
-        """Place every group's initial targets, carriers before the targets they carry."""
+        """Place every group's initial targets, carriers before the targets they carry; linear in their number."""
         order = sorted(range(len(self.sc.groups)), key=lambda i: self.sc.groups[i].motion == "carried")
+        grid = _SpotGrid(max(max(g.size) for g in self.sc.groups))
         for gi in order:
             g = self.sc.groups[gi]
             if g.motion == "carried":
+                self._flush()  # the carriers' rows
                 carriers = np.flatnonzero(self.group == self.sc.group(g.carrier))
                 for slot in carriers[: g.count]:
                     jitter = self.rng.normal(0, 0.1, 2) * self.size[slot]
@@ -144,19 +147,17 @@ class World:
                 continue
             x0, y0, x1, y1 = np.array(g.region) * np.tile(self.extent, 2)
             for _ in range(g.count):
-                self._spawn(gi, self._free_spot(gi, (x0, y0, x1, y1)), self._initial_velocity(g))
+                pos = self._free_spot(g, (x0, y0, x1, y1), grid)
+                size = self._spawn(gi, pos, self._initial_velocity(g))
+                grid.add(g.layer, pos, 0.5 * size.max())
+        self._flush()
 
-    def _free_spot(self, gi: int, region, tries: int = 20) -> np.ndarray:
-        """A point in `region` whose footprint does not overlap a target of the same layer, if one is found."""
-        g = self.sc.groups[gi]
+    def _free_spot(self, g, region, grid: "_SpotGrid", tries: int = 20) -> np.ndarray:
+        """A point in `region` whose footprint does not overlap a placed target of the same layer, if one is found."""
         radius = 0.5 * max(g.size)
-        same = self.layer_of_group[self.group] == g.layer
         for _ in range(tries):
             p = self.rng.uniform(region[:2], region[2:])
-            if not same.any():
-                return p
-            d = np.hypot(*(self.pos[same] - p).T)
-            if (d > radius + 0.5 * self.size[same].max(axis=1)).all():
+            if grid.is_free(g.layer, p, radius):
                 return p
         return p
 
@@ -169,21 +170,31 @@ class World:
             return self.rng.normal(0, g.speed, 2)
         return speed * np.array([math.cos(heading), math.sin(heading)])
 
-    def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None):
-        """Add one target of group `gi`: a row in every state array and a pymunk body."""
+    def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None) -> np.ndarray:
+        """Add one target of group `gi`: a pymunk body now, a row of every state array at the next `_flush`.
+        Returns its size."""
         g = self.sc.groups[gi]
         size = np.array(g.size) * np.exp(g.size_jitter * self.rng.normal(size=2))
         hue = self._hue0 + 0.618034 * self.next_id
         color = (1 - g.similarity) * hue_colors(np.array([hue]))[0] + g.similarity * np.array(g.color)
-        row = dict(ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
-                   cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
-                   goal=self._pick_goal(pos), stopped=False, born=self.t,
-                   carrier_id=0 if carrier is None else int(self.ids[carrier]),
-                   carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier])
-        for name in self._cols:
-            setattr(self, name, np.concatenate([getattr(self, name), np.asarray(row[name])[None].astype(getattr(self, name).dtype)]))
+        self._pending.append(dict(
+            ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
+            cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
+            goal=self._pick_goal(pos), stopped=False, born=self.t,
+            carrier_id=0 if carrier is None else int(self.ids[carrier]),
+            carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier]))
         self.next_id += 1
         self.bodies.append(self._make_body(g, pos, vel, size, carrier))
+        return size
+
+    def _flush(self):
+        """Append the rows of the targets spawned since the last flush, one concatenation per state array."""
+        if self._pending:
+            for name in self._cols:
+                old = getattr(self, name)
+                new = np.array([row[name] for row in self._pending]).astype(old.dtype).reshape(-1, *old.shape[1:])
+                setattr(self, name, np.concatenate([old, new]))
+            self._pending = []
 
     def _make_body(self, g, pos, vel, size, carrier):
         body = pymunk.Body(1.0, float("inf"))  # no rotation: boxes stay axis-aligned
@@ -371,7 +382,7 @@ class World:
                 gi = self.sc.group(d.group) if d.group else 0
                 events += [(gi, d)] * self.rng.poisson(d.birth_rate)
         for gi, door in events:
-            if len(self.ids) >= wcfg.max_alive or (cap >= 0 and self.births >= cap):
+            if len(self.ids) + len(self._pending) >= wcfg.max_alive or (cap >= 0 and self.births >= cap):
                 break
             g = self.sc.groups[gi]
             if door is None:
@@ -383,6 +394,7 @@ class World:
             self._spawn(gi, pos, self._initial_velocity(g, heading))
             self.births += 1
         if self.births != before:
+            self._flush()
             self._sync_order()
 
     def _border_entry(self, g) -> tuple[np.ndarray, float]:
@@ -394,3 +406,34 @@ class World:
         pos, inward = [((inset, u * h), 0.0), ((u * w, inset), 90.0),
                        ((w - inset, u * h), 180.0), ((u * w, h - inset), 270.0)][side]
         return np.array(pos), math.radians(inward + self.rng.uniform(-45, 45))
+
+
+class _SpotGrid:
+    """Placed targets' centres and half-sizes in square cells per layer, so a free-spot test looks only at the
+    targets near the spot: the same answer as testing all of them, at a cost that does not grow with their number."""
+
+    def __init__(self, cell: float):
+        self.cell = max(float(cell), 1.0)
+        self.cells: dict[tuple, list] = {}
+        self.largest: dict[int, float] = {}  # the largest half-size placed on each layer
+
+    def add(self, layer: int, centre: np.ndarray, half: float):
+        cx, cy = (int(v // self.cell) for v in centre)
+        self.cells.setdefault((layer, cx, cy), []).append((centre[0], centre[1], half))
+        self.largest[layer] = max(self.largest.get(layer, 0.0), half)
+
+    def is_free(self, layer: int, p: np.ndarray, radius: float) -> bool:
+        """Whether a footprint of `radius` at p keeps clear of every target on `layer` (centre distance above the sum
+        of the two half-sizes). Cells are visited nearest first and the test stops at the first overlap."""
+        reach = radius + self.largest.get(layer, 0.0)
+        (x0, y0), (x1, y1) = ((int(v // self.cell) for v in p - reach), (int(v // self.cell) for v in p + reach))
+        cx, cy = (int(v // self.cell) for v in p)
+        cells = sorted(((x, y) for x in range(x0, x1 + 1) for y in range(y0, y1 + 1)),
+                       key=lambda c: abs(c[0] - cx) + abs(c[1] - cy))
+        for x, y in cells:
+            placed = self.cells.get((layer, x, y))
+            if placed:
+                rows = np.array(placed)
+                if not (np.hypot(*(rows[:, :2] - p).T) > radius + rows[:, 2]).all():
+                    return False
+        return True

@@ -2,7 +2,10 @@
 
 import dataclasses
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mtt_sim import scenario
 from mtt_sim.scenario import ConfigError, load
@@ -84,3 +87,58 @@ def test_reference_table_documents_every_key():
 
     for key in keys(scenario.Scenario):
         assert f"| `{key}` |" in table
+
+
+def test_mixed_override_forms_merge_and_a_value_given_twice_is_refused():
+    sc = load("crossing", {"sensor.pd": 0.5, "sensor": {"clutter_rate": 3.0}})
+    assert (sc.sensor.pd, sc.sensor.clutter_rate) == (0.5, 3.0)
+    sc = load("crossing", {"sensor": {"clutter_rate": 3.0}, "sensor.pd": 0.5, "groups": {0: {"speed": 1.0}}})
+    assert (sc.sensor.pd, sc.sensor.clutter_rate, sc.groups[0].speed) == (0.5, 3.0, 1.0)
+    with pytest.raises(ConfigError, match=r"override sensor\.pd is given twice"):
+        load("crossing", {"sensor.pd": 0.5, "sensor": {"pd": 0.6}})
+
+
+def test_list_items_and_numpy_numbers_override():
+    sc = load("crossing", {"groups.0.size": {"0": 5.0}, "sensor.pd": np.float32(0.5), "groups.0.count": np.int64(3),
+                           "world.walls": np.bool_(True), "groups.0.color": np.array([1, 2, 3])})
+    assert sc.groups[0].size[0] == 5.0 and sc.sensor.pd == 0.5 and sc.groups[0].count == 3 and sc.world.walls
+    assert sc.groups[0].color == (1, 2, 3)
+    with pytest.raises(ConfigError, match=r"groups\.0\.size\.0 = \{'a': 1\}: expected a finite number"):
+        load("crossing", {"groups.0.size.0": {"a": 1}})
+
+
+VALID_KEYS = ["sensor.pd", "sensor.clutter_rate", "render.width", "world.walls", "groups.0.count", "groups.0.size",
+              "groups.0.size.1", "env.max_steps", "render.camera", "sensor", "groups.0", "groups", "world.size"]
+VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-10**400, 10**400) | st.floats(allow_nan=True) | st.text(max_size=5)
+    | st.sampled_from([np.float32(0.5), np.int64(3), np.bool_(False), np.array([1.0, 2.0])]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.sampled_from(["pd", "0", "count", "x", 1]), inner,
+                                                                  max_size=3),
+    max_leaves=6)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.dictionaries(st.sampled_from(VALID_KEYS) | st.text(max_size=8) | st.integers(-2, 2), VALUES, max_size=4))
+def test_every_override_problem_is_a_config_error(overrides):
+    try:
+        load("crossing", overrides)
+    except ConfigError:
+        pass
+
+
+@settings(max_examples=100, deadline=None)
+@given(pd=st.floats(0, 1), rate=st.floats(0, 100), dotted_first=st.booleans())
+def test_no_override_value_is_ever_dropped(pd, rate, dotted_first):
+    items = [("sensor.pd", pd), ("sensor", {"clutter_rate": rate})]
+    sc = load("crossing", dict(items if dotted_first else items[::-1]))
+    assert (sc.sensor.pd, sc.sensor.clutter_rate) == (pd, rate)
+
+
+def test_totals_are_budgeted_before_anything_is_allocated():
+    with pytest.raises(ConfigError, match=r"would need about 931\.\d GiB .* the budget is 4 GiB"):
+        load("crossing", {"world.size": [100000, 100000]})
+    groups = [{"name": f"g{i}", "count": 10000} for i in range(7)]
+    with pytest.raises(ConfigError, match=r"70000 targets at reset; at most 65535 can be alive at once"):
+        scenario.from_mapping({"groups": groups})
+    with pytest.raises(ConfigError, match=r"world\.max_alive = 100000: out of range"):
+        load("crossing", {"world.max_alive": 100000})

@@ -1,10 +1,12 @@
 """The pymunk world: motion models, collisions, layers, carrying, births and deaths."""
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from helpers import still, tiny
 from mtt_sim.scenario import load
-from mtt_sim.world import World
+from mtt_sim.world import World, _SpotGrid
 
 
 def world(sc, seed=0):
@@ -122,3 +124,28 @@ def test_manoeuvring_targets_turn_and_stop():
         w.step()
         stopped += int(w.stopped.sum())
     assert stopped > 0 and (np.hypot(*w.vel.T) > 0).any()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 100), st.floats(0, 100), st.floats(0.5, 15), st.integers(0, 1)), max_size=40),
+       st.floats(-10, 110), st.floats(-10, 110), st.floats(0.5, 15), st.integers(0, 1))
+def test_spot_grid_answers_as_testing_every_placed_target(placed, x, y, radius, layer):
+    grid = _SpotGrid(cell=12.0)
+    for px, py, half, lay in placed:
+        grid.add(lay, np.array([px, py]), half)
+    same = np.array([(px, py, half) for px, py, half, lay in placed if lay == layer]).reshape(-1, 3)
+    brute = bool((np.hypot(*(same[:, :2] - [x, y]).T) > radius + same[:, 2]).all())
+    assert grid.is_free(layer, np.array([x, y]), radius) == brute
+
+
+def test_placing_targets_costs_linear_work(monkeypatch):
+    """At a fixed density, 4x the targets compare 4x the distances (testing every placed target would be 16x)."""
+    compared = []
+    hypot = np.hypot
+    monkeypatch.setattr(np, "hypot", lambda a, b: compared.append(np.size(a)) or hypot(a, b))
+    work = []
+    for n, side in ((300, 1000.0), (1200, 2000.0)):
+        compared.clear()
+        world(load("dense", {"groups.0.count": n, "world.size": [side, side]}))
+        work.append(sum(compared))
+    assert work[1] < 6 * work[0], work
