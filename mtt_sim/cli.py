@@ -99,6 +99,8 @@ def cmd_perf(args) -> int:
     print()
     print(perf.report_metrics(perf.measure_metrics(repeats=args.repeats)))
     print()
+    print(perf.report_metrics_memory(perf.measure_metrics_memory(repeats=args.repeats)))
+    print()
     print(perf.report_jpda(perf.measure_jpda(repeats=args.repeats)))
     print()
     print(perf.report_lmb(perf.measure_lmb(repeats=args.repeats)))

@@ -70,16 +70,17 @@ def centre_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.norm(centres(a)[:, None] - centres(b)[None], axis=2)
 
 
-def centre_distance_pairs(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Distance between the centres of boxes a[i] and b[i]."""
-    return np.linalg.norm(centres(a) - centres(b), axis=1)
-
-
 def gospa(a: np.ndarray, b: np.ndarray, c: float, p: float) -> float:
     """GOSPA (alpha = 2) between the centres of two sets of boxes, with cut-off c and order p."""
+    return gospa_of_points(centres(a), centres(b), c, p)
+
+
+def gospa_of_points(a: np.ndarray, b: np.ndarray, c: float, p: float) -> float:
+    """GOSPA (alpha = 2) between two point sets (n, 2) and (m, 2), with cut-off c and order p."""
     if not len(a) or not len(b):
         return float((c**p / 2 * (len(a) + len(b))) ** (1 / p))
-    cost = np.minimum(centre_distance(a, b), c) ** p  # assigning at distance >= c costs what leaving both does
+    dx, dy = a[:, 0, None] - b[None, :, 0], a[:, 1, None] - b[None, :, 1]
+    cost = np.minimum(np.sqrt(dx * dx + dy * dy), c) ** p  # assigning at >= c costs what leaving both does
     rows, cols = linear_sum_assignment(cost)
     return float((cost[rows, cols].sum() + c**p / 2 * abs(len(a) - len(b))) ** (1 / p))
 
@@ -116,16 +117,110 @@ class _IdIndex:
 
 
 class _Grow:
-    """A 1-D array that grows (doubling) as new ids appear; `fill` for new slots."""
+    """An array of rows (1-D, or `width` columns) that grows geometrically as rows are needed; `fill` for new rows."""
 
-    def __init__(self, fill, dtype):
-        self.fill, self.a = fill, np.full(16, fill, dtype)
+    def __init__(self, fill, dtype, width: int | None = None, growth: float = 2.0):
+        self.fill, self.growth = fill, growth
+        self.a = np.full((16,) if width is None else (16, width), fill, dtype)
 
     def ensure(self, n: int) -> np.ndarray:
         if n > len(self.a):
-            more = np.full(max(n, 2 * len(self.a)) - len(self.a), self.fill, self.a.dtype)
+            more = np.full((max(n, int(self.growth * len(self.a))) - len(self.a), *self.a.shape[1:]), self.fill,
+                           self.a.dtype)
             self.a = np.concatenate([self.a, more])
         return self.a
+
+
+class _Log(_Grow):
+    """An append-only `_Grow` (growing by a quarter, so at most a fifth of it is unused)."""
+
+    def __init__(self, dtype, width: int | None = None):
+        super().__init__(0, dtype, width, growth=1.25)
+        self.n = 0
+
+    def append(self, rows: np.ndarray):
+        end = self.n + len(rows)
+        self.ensure(end)[self.n: end] = rows
+        self.n = end
+
+    @property
+    def data(self) -> np.ndarray:
+        return self.a[: self.n]
+
+
+_NONE = np.zeros(0, np.intp)
+
+
+class _Episode:
+    """What the global passes need of every frame, stored compactly in a few flat logs: the dense GT and tracker ids,
+    their box centres (GOSPA, centre errors), the nonzero similarities (row, column, value: the only pairs identity and
+    HOTA count) and the CLEAR matches, and per frame the counts n, m, nonzeros and matches (about 15 KB a frame at
+    200 objects, where the similarity matrix alone is 320 KB). Frames wait in a short list and join the logs in
+    batches, so a frame costs a few appends to a list."""
+
+    BATCH = 256
+
+    def __init__(self):
+        self._waiting: list[list] = []  # per frame: g, t, gt boxes, track boxes, rows, cols, sims, match rows, match cols
+        self.counts = _Log(np.int64, 4)
+        self.gt, self.trk = _Log(np.int32), _Log(np.int32)
+        self.gt_xy, self.trk_xy = _Log(np.float64, 2), _Log(np.float64, 2)
+        self.nz_row, self.nz_col, self.nz_sim = _Log(np.int32), _Log(np.int32), _Log(np.float64)
+        self.match_row, self.match_col = _Log(np.int32), _Log(np.int32)
+
+    def add_frame(self, g: np.ndarray, t: np.ndarray, gt_boxes: np.ndarray, trk_boxes: np.ndarray, sim: np.ndarray):
+        if len(self._waiting) >= self.BATCH:
+            self.flush()
+        rows, cols = np.nonzero(sim)
+        self._waiting.append([g, t, gt_boxes, trk_boxes, rows, cols, sim[rows, cols], _NONE, _NONE])
+
+    def add_matches(self, rows: np.ndarray, cols: np.ndarray):
+        """The CLEAR matches (row and column indices within the frame) of the latest frame."""
+        self._waiting[-1][7:] = rows, cols
+
+    def flush(self) -> "_Episode":
+        """Move the waiting frames into the logs; returns self."""
+        if self._waiting:
+            g, t, gb, tb, rows, cols, sims, mr, mc = (np.concatenate(c) for c in zip(*self._waiting))
+            self.counts.append([(len(f[0]), len(f[1]), len(f[4]), len(f[7])) for f in self._waiting])
+            for log, values in ((self.gt, g), (self.trk, t), (self.gt_xy, centres(gb)), (self.trk_xy, centres(tb)),
+                                (self.nz_row, rows), (self.nz_col, cols), (self.nz_sim, sims), (self.match_row, mr),
+                                (self.match_col, mc)):
+                log.append(values)
+            self._waiting = []
+        return self
+
+    def __len__(self) -> int:
+        return self.counts.n + len(self._waiting)
+
+    def nbytes(self) -> int:
+        """Bytes the logs hold (allocated, the unused tail included)."""
+        return sum(log.a.nbytes for log in vars(self.flush()).values() if isinstance(log, _Log))
+
+    def starts(self) -> np.ndarray:
+        """(frames, 4): where each frame's GT rows, tracker rows, nonzeros and matches start in their logs."""
+        counts = self.flush().counts.data
+        return np.cumsum(counts, axis=0) - counts
+
+    def points(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """Frame `index`'s GT and tracker box centres."""
+        if index in (-1, len(self) - 1) and self._waiting:  # the latest frame (every step's GOSPA reward)
+            return centres(self._waiting[-1][2]), centres(self._waiting[-1][3])
+        (n, m, _, _), (g0, t0, _, _) = self.counts.data[index], self.starts()[index]
+        return self.gt_xy.a[g0: g0 + n], self.trk_xy.a[t0: t0 + m]
+
+    def split_points(self) -> tuple[list, list]:
+        """Every frame's GT and tracker box centres, as two lists of arrays."""
+        counts = self.flush().counts.data[:, :2]
+        ends = np.cumsum(counts, axis=0)
+        (g0, t0), (g1, t1) = (ends - counts).T.tolist(), ends.T.tolist()
+        return [self.gt_xy.a[a:b] for a, b in zip(g0, g1)], [self.trk_xy.a[a:b] for a, b in zip(t0, t1)]
+
+    def matches(self) -> tuple[np.ndarray, np.ndarray]:
+        """Episode-wide GT and tracker row indices of every CLEAR match, frame by frame."""
+        starts, counts = self.starts(), self.counts.data
+        frame = np.repeat(np.arange(len(self)), counts[:, 3])
+        return starts[frame, 0] + self.match_row.data, starts[frame, 1] + self.match_col.data
 
 
 class EpisodeMetrics:
@@ -151,9 +246,7 @@ class EpisodeMetrics:
         self._prev_rows = np.zeros(0, np.intp)  # GT indices whose `_prev` is set
         self.tp = self.fp = self.fn = self.idsw = 0
         self.similarity_total = 0.0
-        # per frame, for the global passes: dense GT and tracker ids, similarity, boxes (for GOSPA)
-        self._frames: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
-        self._matches: list[tuple[int, np.ndarray, np.ndarray]] = []  # CLEAR matches: frame, GT rows, track rows
+        self._episode = _Episode()  # what the global passes need of every frame
 
     # ------------------------------------------------------------ per frame
 
@@ -166,11 +259,11 @@ class EpisodeMetrics:
 
     def update(self, gt_ids, gt_boxes, trk_ids, trk_boxes) -> FrameStats:
         """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h."""
-        gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, len(self._frames))
-        trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, len(self._frames))
+        gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, len(self._episode))
+        trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, len(self._episode))
         g, t = self._gt_ids(gt_ids), self._trk_ids(trk_ids)
         sim = self._similarity(gt_boxes, trk_boxes)
-        self._frames.append((g, t, sim, gt_boxes, trk_boxes))
+        self._episode.add_frame(g, t, gt_boxes, trk_boxes, sim)
         if len(self._gt_ids) > len(self._seen.a):
             for arr in (self._last, self._prev, self._seen, self._matched, self._frag):
                 arr.ensure(len(self._gt_ids))
@@ -200,24 +293,27 @@ class EpisodeMetrics:
         prev[self._prev_rows] = -1
         prev[mg] = mt
         self._prev_rows = mg
-        self._matches.append((len(self._frames) - 1, rows, cols))
+        self._episode.add_matches(rows, cols)
         tp, s = len(mg), float(sim[rows, cols].sum())
         fn, fp = len(g) - tp, len(t) - tp
         self.tp, self.fp, self.fn, self.idsw = self.tp + tp, self.fp + fp, self.fn + fn, self.idsw + idsw
         self.similarity_total += s
         return FrameStats(tp, fp, fn, idsw, len(g), s)
 
+    def stored_bytes(self) -> int:
+        """Bytes this episode's frames are kept in (for the global passes of `summary`)."""
+        return self._episode.nbytes()
+
     def frame_gospa(self, index: int = -1) -> float:
         """GOSPA of one stored frame (default: the latest)."""
-        _, _, _, gt_boxes, trk_boxes = self._frames[index]
-        return gospa(gt_boxes, trk_boxes, self.gospa_c, self.gospa_p)
+        return gospa_of_points(*self._episode.points(index), self.gospa_c, self.gospa_p)
 
     # ------------------------------------------------------------ episode
 
     def summary(self) -> dict:
         """All metrics for the frames so far, as a plain dict (see the module docstring for definitions)."""
         num_gt_ids, num_trk_ids = len(self._gt_ids), len(self._trk_ids)
-        flat = _Flat(self._frames, num_gt_ids, num_trk_ids)
+        flat = _Flat(self._episode, num_gt_ids, num_trk_ids)
         seen = self._seen.ensure(num_gt_ids)[:num_gt_ids]
         ratio = self._matched.a[:num_gt_ids][seen > 0] / seen[seen > 0]
         mt = int((ratio > 0.8).sum())
@@ -237,17 +333,24 @@ class EpisodeMetrics:
         out["CentreError"] = float(errors.mean()) if len(errors) else 0.0
         out["CentreErrorVar"] = float(errors.var()) if len(errors) else 0.0
         out.update(self._identity(flat))
-        out.update(_hota(flat, self._frames))
-        out["GOSPA"] = float(np.mean([self.frame_gospa(i) for i in range(len(self._frames))])) if self._frames else 0.0
-        out.update(num_frames=len(self._frames), num_gt_dets=flat.num_gt_dets, num_gt_ids=num_gt_ids,
+        out.update(_hota(flat))
+        out["GOSPA"] = self._mean_gospa()
+        out.update(num_frames=len(self._episode), num_gt_dets=flat.num_gt_dets, num_gt_ids=num_gt_ids,
                    num_tracker_dets=flat.num_trk_dets, num_tracker_ids=num_trk_ids)
         return {k: (float(v) if isinstance(v, (float, np.floating)) else int(v)) for k, v in out.items()}
 
+    def _mean_gospa(self) -> float:
+        """The mean over frames of each frame's GOSPA."""
+        if not len(self._episode):
+            return 0.0
+        c, p = self.gospa_c, self.gospa_p
+        return float(np.mean([gospa_of_points(a, b, c, p) for a, b in zip(*self._episode.split_points())]))
+
     def _match_distances(self) -> tuple[np.ndarray, np.ndarray]:
         """(dense GT index, centre distance) of every CLEAR match so far."""
-        pairs = [(self._frames[f][0][r], centre_distance_pairs(self._frames[f][3][r], self._frames[f][4][c]))
-                 for f, r, c in self._matches]
-        return tuple(np.concatenate(x) for x in zip(*pairs)) if pairs else (np.zeros(0, np.intp), np.zeros(0))
+        ep = self._episode
+        g, t = ep.matches()
+        return ep.gt.data[g].astype(np.intp), np.linalg.norm(ep.gt_xy.data[g] - ep.trk_xy.data[t], axis=1)
 
     def per_target(self) -> dict[int, dict]:
         """Per GT id: Coverage (the fraction of its frames with a CLEAR match) and CentreError (the mean centre
@@ -266,7 +369,7 @@ class EpisodeMetrics:
         hit = flat.sim >= self.threshold
         idtp = 0
         if hit.any():
-            (_, gi), (_, ti) = (np.unique(ids[hit], return_inverse=True) for ids in (flat.gt, flat.trk))
+            gi, ti = _ranks(flat.gt[hit], len(flat.gt_count)), _ranks(flat.trk[hit], len(flat.trk_count))
             potential = np.zeros((gi.max() + 1, ti.max() + 1))
             np.add.at(potential, (gi, ti), 1)
             rows, cols = linear_sum_assignment(potential, maximize=True)
@@ -281,31 +384,40 @@ class _Flat:
 
     This lets the global passes (identity, HOTA) run as a handful of vectorised operations over the
     whole episode instead of a Python loop of small ones per frame; pairs of zero similarity never
-    count towards either, so only the nonzero entries are kept (`dense` is every frame's matrix, raveled).
+    count towards either. Entries run frame by frame, row-major within a frame (as np.nonzero gives them).
     """
 
-    def __init__(self, frames: list, num_gt_ids: int, num_trk_ids: int):
-        n = np.array([len(f[0]) for f in frames], np.int64).reshape(-1)
-        m = np.array([len(f[1]) for f in frames], np.int64).reshape(-1)
-        self.n, self.m, sizes = n, m, n * m
-        self.start = np.cumsum(sizes) - sizes
-        empty = np.zeros(0, np.intp)
-        gcat = np.concatenate([f[0] for f in frames] or [empty])
-        tcat = np.concatenate([f[1] for f in frames] or [empty])
-        self.dense = np.concatenate([f[2].ravel() for f in frames] or [np.zeros(0)])
-        self.idx = np.flatnonzero(self.dense)
-        self.sim = self.dense[self.idx]
-        frame = np.searchsorted(self.start, self.idx, side="right") - 1
-        local = self.idx - self.start[frame]
-        self.row = (np.cumsum(n) - n)[frame] + local // m[frame]  # index into the concatenated GT ids
-        self.col = (np.cumsum(m) - m)[frame] + local % m[frame]   # index into the concatenated tracker ids
+    def __init__(self, ep: _Episode, num_gt_ids: int, num_trk_ids: int):
+        starts, counts = ep.starts(), ep.counts.data
+        self.n, self.m, self.nnz = counts[:, 0], counts[:, 1], counts[:, 2]
+        self.frame = np.repeat(np.arange(len(ep)), self.nnz)  # each entry's frame
+        self.local_row, self.local_col = ep.nz_row.data, ep.nz_col.data
+        self.row = starts[self.frame, 0] + self.local_row  # index into the episode's GT rows
+        self.col = starts[self.frame, 1] + self.local_col  # index into the episode's tracker rows
+        self.sim = ep.nz_sim.data
+        gcat, tcat = ep.gt.data, ep.trk.data
         self.gt, self.trk = gcat[self.row], tcat[self.col]
         self.gt_count = np.bincount(gcat, minlength=num_gt_ids)
         self.trk_count = np.bincount(tcat, minlength=num_trk_ids)
         self.num_gt_dets, self.num_trk_dets = len(gcat), len(tcat)
 
+    def crowded(self) -> np.ndarray:
+        """Per frame, whether some row or column holds two nonzero entries: only these frames need an assignment
+        solved."""
+        twice = (np.bincount(self.row)[self.row] > 1) | (np.bincount(self.col)[self.col] > 1)
+        out = np.zeros(len(self.n), bool)
+        out[self.frame[twice]] = True
+        return out
 
-def _hota(flat: _Flat, frames: list) -> dict:
+
+def _ranks(ids: np.ndarray, size: int) -> np.ndarray:
+    """Each id's rank among the distinct ids present (np.unique's inverse, for ids in 0..size-1, without sorting)."""
+    present = np.zeros(size, bool)
+    present[ids] = True
+    return (np.cumsum(present) - 1)[ids]
+
+
+def _hota(flat: _Flat) -> dict:
     """HOTA (TrackEval): global alignment from similarity-normalised co-occurrence, then per-frame matching."""
     sim, n_alpha = flat.sim, len(HOTA_ALPHAS)
     # pass 1: each pair's similarity normalised by its row and column sums (a soft IoU of the two tracks)
@@ -317,29 +429,35 @@ def _hota(flat: _Flat, frames: list) -> dict:
     pair_keys, pair = np.unique(flat.gt.astype(np.int64) * n_trk + flat.trk, return_inverse=True)
     potential = np.bincount(pair, weights=soft, minlength=len(pair_keys))
     gc, tc = flat.gt_count[pair_keys // n_trk], flat.trk_count[pair_keys % n_trk]
-    score = np.zeros_like(flat.dense)
-    score[flat.idx] = (potential / (gc + tc - potential))[pair] * sim
-    # pass 2: per frame, the assignment maximising alignment x similarity
-    matched = []
-    for k in np.flatnonzero(flat.n * flat.m):
-        n, m, start = int(flat.n[k]), int(flat.m[k]), int(flat.start[k])
-        rows, cols = linear_sum_assignment(score[start: start + n * m].reshape(n, m), maximize=True)
-        matched.append(start + rows * m + cols)
-    idx = np.concatenate(matched) if matched else np.zeros(0, np.intp)
-    idx = idx[flat.dense[idx] > 0]  # a match of zero similarity counts at no alpha
-    s = flat.dense[idx]
-    hit = s[None, :] >= HOTA_ALPHAS[:, None] - EPS  # (alphas, matches)
-    tp = hit.sum(axis=1).astype(float)
-    fn, fp = flat.num_gt_dets - tp, flat.num_trk_dets - tp
-    loc = (hit * s).sum(axis=1)
-    a_idx, m_idx = np.nonzero(hit)
-    matched_pair = pair[np.searchsorted(flat.idx, idx)]
-    combos, counts = np.unique(a_idx * len(pair_keys) + matched_pair[m_idx], return_counts=True)
-    a, p = combos // max(len(pair_keys), 1), combos % max(len(pair_keys), 1)
-    ass_a, ass_re, ass_pr = (np.zeros(n_alpha) for _ in range(3))
-    for out, d in ((ass_a, gc[p] + tc[p] - counts), (ass_re, gc[p]), (ass_pr, tc[p])):
-        np.add.at(out, a, counts * counts / np.maximum(1, d))
+    score = (potential / (gc + tc - potential))[pair] * sim
+    # pass 2: per frame, the assignment maximising alignment x similarity. Where no row or column holds two nonzero
+    # entries, any optimal assignment takes every entry, so only the crowded frames need one solved.
+    crowded = flat.crowded()
+    chosen = ~crowded[flat.frame]
+    bounds = np.r_[0, np.cumsum(flat.nnz)]
+    for k in np.flatnonzero(crowded).tolist():
+        e0, e1, shape = bounds[k], bounds[k + 1], (flat.n[k], flat.m[k])
+        r, c = flat.local_row[e0:e1], flat.local_col[e0:e1]
+        dense, entry = np.zeros(shape), np.full(shape, -1)
+        dense[r, c], entry[r, c] = score[e0:e1], np.arange(e0, e1)
+        picked = entry[linear_sum_assignment(dense, maximize=True)]
+        chosen[picked[picked >= 0]] = True  # a match of zero similarity counts at no alpha
+    idx = np.flatnonzero(chosen)  # frame by frame, by row within a frame, as TrackEval's loop gives them
+    s, matched_pair = sim[idx], pair[idx]
+    # per alpha (one at a time, so memory stays at a few arrays of the matches): TP, summed similarity, and the
+    # association scores from each pair's matched count; sums run in the order TrackEval's arrays give them
+    tp, loc, ass_a, ass_re, ass_pr = (np.zeros(n_alpha) for _ in range(5))
+    for a, alpha in enumerate(HOTA_ALPHAS):
+        hit = s >= alpha - EPS
+        tp[a], loc[a] = np.count_nonzero(hit), np.where(hit, s, 0.0).sum()
+        counts = np.bincount(matched_pair[hit], minlength=len(pair_keys))
+        p = np.flatnonzero(counts)
+        counts = counts[p]
+        for out, d in ((ass_a, gc[p] + tc[p] - counts), (ass_re, gc[p]), (ass_pr, tc[p])):
+            out[a] = np.cumsum(counts * counts / np.maximum(1, d))[-1] if len(p) else 0.0
+    for out in (ass_a, ass_re, ass_pr):
         out /= np.maximum(1, tp)
+    fn, fp = flat.num_gt_dets - tp, flat.num_trk_dets - tp
     det_a = tp / np.maximum(1, tp + fn + fp)
     hota = np.sqrt(det_a * ass_a)
     loc_a = np.maximum(1e-10, loc) / np.maximum(1e-10, tp)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import statistics
 import time
+import tracemalloc
 
 import cv2
 import numpy as np
@@ -123,6 +124,30 @@ def report_metrics(rows: list[dict]) -> str:
     out += [f"| {r['objects']} | {r['frames']} | {r['update_us']:.0f} us | {r['reference_us']:.0f} us | "
             f"{r['update_over_reference']:.2f}x | {r['summary_s'] * 1e3:.1f} ms |" for r in rows]
     return "\n".join(out)
+
+
+def measure_metrics_memory(repeats: int = 5, objects: int = 200, frames: int = 3000) -> dict:
+    """What a long episode's metrics keep: bytes stored per frame, the summary's median time and its peak memory
+    (tracemalloc, in one more run) over what is stored."""
+    seq = _sequence(objects, 1000)
+    m = EpisodeMetrics()
+    for k in range(frames):
+        m.update(*seq[k % len(seq)])
+    stored = m.stored_bytes()
+    summary_s = statistics.median(_time(m.summary) for _ in range(repeats))
+    tracemalloc.start()
+    m.summary()
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return {"objects": objects, "frames": frames, "kb_per_frame": stored / frames / 1024, "summary_s": summary_s,
+            "peak_over_stored": peak / stored}
+
+
+def report_metrics_memory(row: dict) -> str:
+    return "\n".join(["EpisodeMetrics memory of a long episode (summary time: median)",
+                      "| objects | frames | stored per frame | summary | summary peak / stored |", "|---:|---:|---:|---:|---:|",
+                      f"| {row['objects']} | {row['frames']} | {row['kb_per_frame']:.1f} KB | {row['summary_s']:.2f} s | "
+                      f"{row['peak_over_stored']:.2f}x |"])
 
 
 def _recorded_detections(n: int, frames: int, clutter: float = 5.0, with_frames: bool = False):

@@ -1,6 +1,7 @@
 """Metrics: hand-computed answers, TrackEval's quirks, a cross-check against a dense re-statement, properties."""
 
 import math
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -135,13 +136,9 @@ def test_bad_input_names_the_frame_and_the_problem():
 
 # ------------------------------------------------------------------ properties
 
-@st.composite
-def sequences(draw):
-    """Random GT tracks and noisy, sometimes swapped, sometimes missing tracks over a few frames."""
-    n_frames, n_gt = draw(st.integers(1, 8)), draw(st.integers(0, 5))
-    seed = draw(st.integers(0, 2**32 - 1))
-    rng = np.random.default_rng(seed)
-    pos = rng.uniform(0, 60, (n_gt, 2))
+def random_sequence(rng, n_frames, n_gt, spread=60.0):
+    """Random GT tracks and noisy, sometimes swapped, sometimes missing tracks over `n_frames` frames."""
+    pos = rng.uniform(0, spread, (n_gt, 2))
     gt, tracks = [], []
     for _ in range(n_frames):
         pos += rng.normal(0, 3, pos.shape)
@@ -153,10 +150,16 @@ def sequences(draw):
         tb = boxes[keep] + rng.normal(0, 1.5, (keep.sum(), 4)) * [1, 1, 0.3, 0.3]
         tid = rng.permutation(10)[: keep.sum()] if rng.random() < 0.3 else np.flatnonzero(keep) + 100
         extra = int(rng.integers(0, 3))  # false tracks
-        tb = np.r_[tb, np.c_[rng.uniform(0, 70, (extra, 2)), np.full((extra, 2), 10.0)]]
+        tb = np.r_[tb, np.c_[rng.uniform(0, spread + 10, (extra, 2)), np.full((extra, 2), 10.0)]]
         tid = np.r_[tid, 1000 + np.arange(extra)]
         tracks.append((tid, tb))
     return gt, tracks
+
+
+@st.composite
+def sequences(draw):
+    n_frames, n_gt = draw(st.integers(1, 8)), draw(st.integers(0, 5))
+    return random_sequence(np.random.default_rng(draw(st.integers(0, 2**32 - 1))), n_frames, n_gt)
 
 
 @settings(max_examples=150, deadline=None)
@@ -203,3 +206,36 @@ def test_bounds_and_incremental_equals_batch(seq):
        st.lists(st.tuples(*[st.floats(0, 50)] * 2, *[st.floats(0.1, 20)] * 2), min_size=1, max_size=6))
 def test_iou_matches_the_plain_loop(a, b):
     np.testing.assert_allclose(box_iou(np.array(a), np.array(b)), ref.iou(a, b), atol=1e-12)
+
+
+def test_a_long_episode_matches_the_dense_restatement_and_every_frame_keeps_its_gospa():
+    """Past the batches in which frames are stored (256), with crowded frames (boxes overlapping several others)."""
+    gt, tracks = random_sequence(np.random.default_rng(3), 600, 8, spread=30.0)
+    ours, theirs = evaluate(gt, tracks), ref.evaluate(gt, tracks)
+    for key, value in theirs.items():
+        assert ours[key] == pytest.approx(value, abs=1e-9), key
+    m = EpisodeMetrics()
+    for k, ((gi, gb), (ti, tb)) in enumerate(zip(gt, tracks)):
+        m.update(gi, gb, ti, tb)
+        assert m.frame_gospa() == gospa(gb, tb, 50.0, 1.0)
+    for k in (0, 255, 256, 300, 599, -1):
+        assert m.frame_gospa(k) == gospa(gt[k][1], tracks[k][1], 50.0, 1.0)
+
+
+def test_a_long_episode_keeps_little_per_frame():
+    """Only the nonzero similarities are kept: 200 objects a frame cost under 20 KB (a dense matrix alone: 320 KB),
+    and the summary's peak stays within a small factor of that."""
+    rng = np.random.default_rng(0)
+    frames = [(np.arange(200), np.c_[rng.uniform(0, 600, (200, 2)), np.full((200, 2), 24.0)]) for _ in range(20)]
+    m = EpisodeMetrics()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    for k in range(300):
+        ids, boxes = frames[k % 20]
+        m.update(ids, boxes, ids, boxes + rng.normal(0, 2, boxes.shape))
+    stored = tracemalloc.get_traced_memory()[0] - before
+    tracemalloc.reset_peak()
+    m.summary()
+    peak = tracemalloc.get_traced_memory()[1] - before
+    tracemalloc.stop()
+    assert stored / 300 < 20 * 1024 and peak < 4 * stored, (stored / 300, peak / stored)
