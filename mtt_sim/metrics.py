@@ -206,7 +206,8 @@ class _Episode:
         """Frame `index`'s GT and tracker box centres."""
         if index in (-1, len(self) - 1) and self._waiting:  # the latest frame (every step's GOSPA reward)
             return centres(self._waiting[-1][2]), centres(self._waiting[-1][3])
-        (n, m, _, _), (g0, t0, _, _) = self.counts.data[index], self.starts()[index]
+        starts = self.starts()
+        (n, m, _, _), (g0, t0, _, _) = self.counts.data[index], starts[index]
         return self.gt_xy.a[g0: g0 + n], self.trk_xy.a[t0: t0 + m]
 
     def split_points(self) -> tuple[list, list]:
