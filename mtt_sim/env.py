@@ -8,16 +8,15 @@ frame, renders it, runs the detector and returns the next observation.
 from __future__ import annotations
 
 import os
-import re
 from collections import deque
 from typing import Any, Mapping
 
-import cv2
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from . import scenario as scn
+from . import viewer
 from .metrics import EpisodeMetrics, FrameStats
 from .overlay import draw_overlay
 from .render import Renderer
@@ -61,7 +60,7 @@ class TrackingEnv(gym.Env):
     and the rest (see ``mtt_sim.metrics``). ``env.unwrapped.truth`` is the current ground truth.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 25}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 25}  # an instance lists those that work here
 
     def __init__(self, scenario: str | os.PathLike | scn.Scenario = "crossing", config: Mapping | None = None,
                  render_mode: str | None = None, obs_mode: str | None = None):
@@ -73,9 +72,13 @@ class TrackingEnv(gym.Env):
         self._overrides = overrides
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode={render_mode!r}: allowed values: None, 'rgb_array', 'human'")
-        if render_mode == "human":
-            _require_display()
+        # "human" needs pygame and a display: where they are missing it is left out of this env's modes (so
+        # Gymnasium's check_env checks the modes that work here), and asking for it says how to get it
+        self.metadata = {**self.metadata, "render_modes": ["rgb_array"] + (["human"] if viewer.available() else [])}
+        if render_mode == "human" and "human" not in self.metadata["render_modes"]:
+            raise gym.error.DependencyNotInstalled(viewer.HOW)
         self.render_mode = render_mode
+        self._viewer = viewer.Viewer("mtt-sim", self.metadata["render_fps"]) if render_mode == "human" else None
         self.observation_space, self.action_space = self._spaces(self.scenario)
         self.world: World | None = None
         self._done = True
@@ -126,6 +129,8 @@ class TrackingEnv(gym.Env):
         seen = self.truth.visibility > 0
         info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy(),
                 "image_size": (sc.render.width, sc.render.height)}
+        if self._viewer:
+            self.render()
         return obs, info
 
     def _reconfigure(self, config: Mapping):
@@ -155,6 +160,8 @@ class TrackingEnv(gym.Env):
         info = {"frame_index": self.steps, "frame": dict(vars(stats))}
         if self._done:
             info["metrics"] = self.metrics.summary()
+        if self._viewer:
+            self.render()
         return obs, float(reward), terminated, truncated, info
 
     def _reward(self, stats: FrameStats) -> float:
@@ -186,7 +193,8 @@ class TrackingEnv(gym.Env):
     # ------------------------------------------------------------ actions
 
     def validate_action(self, action) -> tuple[np.ndarray, np.ndarray]:
-        """The action's tracks as (ids int64 (n,), boxes float32 (n, 4)), or an ActionError saying what is wrong."""
+        """The action's tracks as (ids int64 (n,), boxes float32 (n, 4)), or an ActionError saying what is wrong. Boxes
+        are checked as float32, the dtype they are scored and drawn in, against the action space's bounds."""
         nt = self.scenario.env.max_tracks
         if not isinstance(action, Mapping) or not {"ids", "boxes"} <= set(action):
             raise ActionError("action must be a dict with 'ids' and 'boxes' (and 'num_tracks' when padded), "
@@ -201,6 +209,8 @@ class TrackingEnv(gym.Env):
                 raise ActionError(f"padded action: 'ids' must have shape ({nt},) and 'boxes' ({nt}, 4), got "
                                   f"{ids.shape} and {boxes.shape}")
             ids, boxes = ids[:n], boxes[:n]
+        elif ids.size == 0 and boxes.size == 0:  # nothing reported, e.g. {"ids": [], "boxes": []}
+            ids, boxes = ids.reshape(0), boxes.reshape(0, 4)
         elif ids.ndim != 1 or boxes.shape != (len(ids), 4) or len(ids) > nt:
             raise ActionError(f"unpadded action: 'ids' must have shape (n,) and 'boxes' (n, 4) with n <= {nt}, got "
                               f"{ids.shape} and {boxes.shape}")
@@ -208,19 +218,33 @@ class TrackingEnv(gym.Env):
             return np.zeros(0, np.int64), np.zeros((0, 4), np.float32)
         if not np.issubdtype(ids.dtype, np.integer):
             raise ActionError(f"action['ids'] must be integers, got dtype {ids.dtype}")
-        if not np.issubdtype(boxes.dtype, np.number):
-            raise ActionError(f"action['boxes'] must be numbers, got dtype {boxes.dtype}")
+        if not np.issubdtype(boxes.dtype, np.number) or np.iscomplexobj(boxes):
+            raise ActionError(f"action['boxes'] must be real numbers, got dtype {boxes.dtype}")
+        space = self.action_space["ids"]
+        out = (ids < space.low[0]) | (ids > space.high[0])
+        if out.any():
+            raise ActionError(f"action['ids'] {ids[out][0]} is outside 0..{int(space.high[0])}")
+        with np.errstate(over="ignore"):
+            boxes = boxes.astype(np.float32)
         bad = ~np.isfinite(boxes).all(axis=1)
         if bad.any():
-            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(bad)[0])} is not finite: {boxes[bad][0].tolist()}")
+            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(bad)[0])} is not finite as float32: "
+                              f"{np.asarray(action['boxes'])[: len(boxes)][bad][0].tolist()}")
         small = (boxes[:, 2] <= 0) | (boxes[:, 3] <= 0)
         if small.any():
-            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(small)[0])} has a non-positive width or height: "
-                              f"{boxes[small][0].tolist()} (boxes are x, y, w, h)")
+            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(small)[0])} has a non-positive width or height as "
+                              f"float32: {boxes[small][0].tolist()} (boxes are x, y, w, h)")
+        low, high = self.action_space["boxes"].low[0], self.action_space["boxes"].high[0]
+        outside = ((boxes < low) | (boxes > high)).any(axis=1)
+        if outside.any():
+            (x0, y0, _, _), (x1, y1, w1, h1) = low.tolist(), high.tolist()
+            raise ActionError(f"action['boxes'] row {int(np.flatnonzero(outside)[0])} = {boxes[outside][0].tolist()} "
+                              f"lies outside the action space: x in [{x0:g}, {x1:g}], y in [{y0:g}, {y1:g}], w in "
+                              f"(0, {w1:g}], h in (0, {h1:g}] (at most one image beyond each border)")
         uniq, counts = np.unique(ids, return_counts=True)
         if (counts > 1).any():
             raise ActionError(f"action['ids'] must be unique within a frame; repeated: {uniq[counts > 1].tolist()}")
-        return ids.astype(np.int64), boxes.astype(np.float32)
+        return ids.astype(np.int64), boxes
 
     def remember_tracks(self, ids, boxes):
         """The tracks to draw on the current frame, and their trails (step() records its action's tracks
@@ -240,22 +264,22 @@ class TrackingEnv(gym.Env):
     # ------------------------------------------------------------ rendering
 
     def render(self):
-        """rgb_array: the frame with ground truth, detections and the last tracks drawn on; human: show it."""
+        """rgb_array: the frame with ground truth, detections and the last tracks drawn on; human: show it in a window
+        (which reset and step also do)."""
         if self.world is None:
             raise RuntimeError("render() needs reset() first")
         if self.render_mode is None:
             gym.logger.warn("render() called with render_mode=None; make the env with render_mode='rgb_array'")
             return None
         img = draw_overlay(self.frame, self.truth, self.detections.rows, *self._last_tracks, self._trails)
-        if self.render_mode == "human":
-            cv2.imshow("mtt-sim", cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
-            cv2.waitKey(1)
+        if self._viewer:
+            self._viewer.show(img)
             return None
         return img
 
     def close(self):
-        if self.render_mode == "human":
-            cv2.destroyAllWindows()
+        if self._viewer:
+            self._viewer.close()
 
 
 def _get(sc: scn.Scenario, dotted: str):
@@ -263,12 +287,3 @@ def _get(sc: scn.Scenario, dotted: str):
     for part in dotted.split("."):
         obj = getattr(obj, part)
     return obj
-
-
-def _require_display():
-    """render_mode='human' needs a display and an OpenCV with a GUI backend; say so plainly when either is missing."""
-    gui = re.search(r"GUI:\s+NONE", cv2.getBuildInformation()) is None
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) or not gui:
-        raise gym.error.DependencyNotInstalled(
-            "render_mode='human' needs a display and an OpenCV build with a GUI (opencv-python-headless has none). "
-            "Use render_mode='rgb_array' and save a video: `mtt-sim run <scenario> --video out.mp4`.")

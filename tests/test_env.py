@@ -1,5 +1,9 @@
 """The Gym face: registration, checker, determinism, vector envs, action validation, episode ends."""
 
+import os
+import subprocess
+import sys
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -8,6 +12,7 @@ from gymnasium.utils.env_checker import check_env
 import mtt_sim
 from helpers import still, tiny
 from mtt_sim import ActionError, ConfigError, TrackingEnv
+from mtt_sim.env import NO_TRACKS
 
 ENV_IDS = sorted(mtt_sim.env_ids().values())
 NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4), np.float32)}
@@ -21,7 +26,7 @@ def echo(obs):
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_check_env_passes(env_id):
     env = gym.make(env_id)
-    check_env(env.unwrapped, skip_render_check=True)
+    check_env(env.unwrapped)  # with its render check: every mode this machine can render
 
 
 def test_every_scenario_has_one_env_id():
@@ -105,12 +110,26 @@ def test_reset_info_gives_the_visible_initial_targets():
     ({"ids": [1.5], "boxes": [[0, 0, 5, 5]]}, r"action\['ids'\] must be integers"),
     ({"ids": np.zeros(256, np.int64), "boxes": np.ones((256, 4)), "num_tracks": 999}, r"num_tracks'\] = 999: must be an integer in 0\.\.256"),
     ({"ids": np.zeros(3, np.int64), "boxes": np.ones((3, 4)), "num_tracks": 1}, r"padded action: 'ids' must have shape \(256,\)"),
+    ({"ids": [1], "boxes": [[1e39, 0, 5, 5]]}, r"row 0 is not finite as float32: \[1e\+39, 0\.0, 5\.0, 5\.0\]"),
+    ({"ids": [1], "boxes": [[0, 0, 1e-50, 5]]}, r"row 0 has a non-positive width or height as float32"),
+    ({"ids": [1], "boxes": [[1e30, 0, 5, 5]]}, r"row 0 = .* lies outside the action space: x in \[-384, 768\], y in "
+                                                r"\[-288, 576\], w in \(0, 768\], h in \(0, 576\]"),
+    ({"ids": [1], "boxes": [[0, 0, 5, 900]]}, r"row 0 = \[0\.0, 0\.0, 5\.0, 900\.0\] lies outside the action space"),
+    ({"ids": [-1], "boxes": [[0, 0, 5, 5]]}, r"action\['ids'\] -1 is outside 0\.\.2147483647"),
+    ({"ids": [1], "boxes": [["a", "b", "c", "d"]]}, r"action\['boxes'\] must be real numbers"),
 ])
 def test_bad_actions_say_what_is_wrong(action, pattern):
     env = TrackingEnv("crossing")
     env.reset(seed=0)
     with pytest.raises(ActionError, match=pattern):
         env.step(action)
+
+
+def test_an_empty_action_in_any_form_reports_nothing():
+    env = TrackingEnv("crossing")
+    env.reset(seed=0)
+    for action in ({"ids": [], "boxes": []}, {"ids": np.zeros(0, int), "boxes": np.zeros((0, 4))}, NO_TRACKS):
+        assert env.step(action)[4]["frame"]["fp"] == 0
 
 
 def test_padded_action_counts_only_num_tracks_rows():
@@ -153,11 +172,36 @@ def test_terminated_when_everyone_left_and_truncated_at_max_steps():
     assert flags == [False, False, True]
 
 
-def test_human_render_without_display_says_so(monkeypatch):
-    monkeypatch.delenv("DISPLAY", raising=False)
-    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
-    with pytest.raises(gym.error.DependencyNotInstalled, match="needs a display"):
+def test_human_render_without_a_viewer_says_how_to_get_one(monkeypatch):
+    for var in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"):
+        monkeypatch.delenv(var, raising=False)
+    with pytest.raises(gym.error.DependencyNotInstalled, match=r"pip install 'mtt-sim\[viewer\]', on a machine with a "
+                                                                r"display"):
         gym.make("mtt_sim/Crossing-v0", render_mode="human")
+    assert gym.make("mtt_sim/Crossing-v0").unwrapped.metadata["render_modes"] == ["rgb_array"]
+
+
+HUMAN = """
+import gymnasium as gym, numpy as np, mtt_sim, pygame
+from gymnasium.utils.env_checker import check_env
+shown = []
+for mode in ("human", "rgb_array"):
+    env = gym.make("mtt_sim/Crossing-v0", render_mode=mode)
+    check_env(env.unwrapped)  # renders in every mode, "human" included
+    env.reset(seed=0)
+    env.step({"ids": [1], "boxes": [[10.0, 10.0, 20.0, 30.0]]})  # human: step shows the frame
+    shown.append(pygame.surfarray.array3d(pygame.display.get_surface()).swapaxes(0, 1) if mode == "human" else env.render())
+    env.close()
+print(shown[0].shape, int(np.array_equal(*shown)))
+"""
+
+
+def test_human_render_shows_the_annotated_frame_in_a_pygame_window():
+    pytest.importorskip("pygame")
+    out = subprocess.run([sys.executable, "-c", HUMAN], capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["(288,", "384,", "3)", "1"]  # the window shows what rgb_array returns
 
 
 def test_truth_is_exposed_on_the_unwrapped_env():

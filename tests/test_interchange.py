@@ -112,3 +112,41 @@ def test_external_adapter_runs_a_third_party_tracker_in_the_gym_loop():
         trackers.External(SortReferenceStyle(), box_format="tlbr")
     with pytest.raises(TypeError, match="has no update"):
         trackers.External(object()).reset({})
+
+
+class Returns:
+    """A model whose update() returns a fixed value."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def update(self, dets):
+        return self.value
+
+
+@pytest.mark.parametrize("value, pattern", [
+    (None, r"\(m, >= 5\) array of boxes and track ids, got NoneType of shape \(\)"),
+    ("tracks", r"got str"),
+    ([[1, 2, 3, 4, 5], [1, 2]], r"got list"),
+    (np.zeros((2, 4)), r"got ndarray of shape \(2, 4\)"),
+    (np.zeros((2, 5, 1)), r"got ndarray of shape \(2, 5, 1\)"),
+    ([[0, 0, 5, 5, np.nan]], r"row 0 is not finite"),
+    ([[0, 0, 5, 5, 1.5]], r"track ids must be integers in 0..2\*\*31-1, row 0 has 1.5"),
+    ([[0, 0, 5, 5, -1]], r"row 0 has -1"),
+    ([[0, 0, 5, 5, 3], [9, 9, 12, 12, 3]], r"must be unique within a frame; repeated: \[3\]"),
+])
+def test_malformed_third_party_output_gets_one_clear_error(value, pattern):
+    t = trackers.External(Returns(value))
+    t.reset({})
+    with pytest.raises(ValueError, match=pattern):
+        t.update({"detections": np.zeros((1, 5)), "num_detections": 0})
+
+
+def test_third_party_output_of_one_track_or_none_is_read():
+    t = trackers.External(Returns([0, 0, 5, 6, 7]))
+    t.reset({})
+    tracks = t.update({"detections": np.zeros((1, 5)), "num_detections": 0})
+    assert tracks.ids.tolist() == [7] and tracks.boxes.tolist() == [[0, 0, 5, 6]]
+    t = trackers.External(Returns([]))
+    t.reset({})
+    assert len(t.update({"detections": np.zeros((1, 5)), "num_detections": 0})) == 0

@@ -167,7 +167,7 @@ def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_siz
     assert {d["kind"] for d in drawn} == {"ellipse", "text"}
     with pytest.raises(ValueError, match="image size"):
         trackers.make("lmb").reset({})
-    with pytest.raises(ValueError, match="birth='sometimes': allowed values: 'adaptive', 'fixed'"):
+    with pytest.raises(ValueError, match="birth='sometimes': allowed: 'adaptive', 'fixed'"):
         trackers.make("lmb:birth=sometimes").reset(INFO)
 
 

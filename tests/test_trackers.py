@@ -91,24 +91,104 @@ def test_registry_and_parameters():
     assert t.params == {"max_age": 4, "min_hits": 1, "iou_threshold": 0.2, "min_confidence": 0.0}
     with pytest.raises(ValueError, match="unknown tracker 'deepsort'; available: " + ", ".join(sorted(trackers.available()))):
         trackers.make("deepsort")
-    with pytest.raises(ValueError, match=r"tracker 'sort': unknown parameter 'max_ages'; allowed: max_age \(default 1\)"):
+    with pytest.raises(ValueError, match=r"tracker 'sort': unknown parameter 'max_ages' \(did you mean 'max_age'\?\); "
+                                         r"allowed: max_age \(default 1\)"):
         trackers.make("sort", max_ages=3)
-    with pytest.raises(ValueError, match=r"parameter max_age='three' must be a int"):
+    with pytest.raises(ValueError, match=r"parameter max_age='three': allowed: an integer in \[0, inf\) \(default 1\)"):
         trackers.make("sort:max_age=three")
-    with pytest.raises(ValueError, match=r"parameter min_hits=1.5 must be a int"):
+    with pytest.raises(ValueError, match=r"parameter min_hits=1.5: allowed: an integer"):
         trackers.make("sort", min_hits=1.5)
     assert trackers.make("gnn:coast=true").params["coast"] is True
+    assert trackers.make("sort", max_age=np.int64(2), iou_threshold=np.float32(0.5)).params["max_age"] == 2
 
 
-def test_bad_observations_say_what_is_wrong():
-    t = trackers.make("sort")
-    t.reset({})
-    with pytest.raises(ValueError, match="needs the env's observation"):
-        t.update(np.zeros((3, 5)))
-    bad = np.zeros((4, 5), np.float32)
-    bad[1, 2] = np.nan
-    with pytest.raises(ValueError, match="detection row 1 is not finite"):
-        t.update({"detections": bad, "num_detections": 2})
+ABSURD = ["sort:max_age=-5", "sort:min_hits=-1", "sort:iou_threshold=1.5", "sort:iou_threshold=nan", "iou:t_min=0",
+          "iou:sigma_iou=-0.1", "gnn:gate_probability=1", "gnn:meas_sigma=0", "gnn:accel_sigma=-1", "gnn:max_age=1e400",
+          "bytetrack:track_buffer=-3", "bytetrack:match_thresh=2", "jpda:pd=0", "jpda:pd=1.2", "jpda:clutter_density=0",
+          "jpda:vanish_frames=0", "jpda:k=-2", "jpda:occlusion_velocity=fast", "jpda_exact:max_exact_targets=60",
+          "lmb:hypotheses=0", "lmb:survival=0", "lmb:detection=1.5", "lmb:birth=nope", "lmb:max_components=0",
+          "lmb:measurement_noise=-0.1", "gmphd:prune=1", "gmphd:max_components=0", "pf:particles=0",
+          "pf:particles=10000000", "pf:alpha=2", "pf:levels=1", "ipf:particles=-1", "ipf:h_levels=1000",
+          "ipf:conflict_ratio=0", "pcpf:velocity_gain=-1", "sort:max_age=2.5", "gnn:coast=yes"]
+
+
+@pytest.mark.parametrize("spec", ABSURD)
+def test_absurd_parameter_values_are_refused_with_what_is_allowed(spec):
+    with pytest.raises(ValueError, match=r"parameter \w+=.*: allowed: .*\(default "):
+        trackers.make(spec)
+
+
+def test_every_numeric_parameter_has_a_range():
+    """Only thresholds on detector confidences (raw scores may lie outside [0, 1]) take any finite number."""
+    for name, cls in trackers.base.REGISTRY.items():
+        for key, param in cls.parameters.items():
+            if param.allowed == "(-inf, inf)" and not isinstance(param.default, bool):
+                assert "confidence" in key or key in ("sigma_l", "sigma_h", "track_thresh", "low_thresh",
+                                                      "new_track_thresh"), (name, key)
+            assert param.check(name, key, param.default) == param.default, (name, key)
+
+
+GOOD = np.array([[10, 10, 5, 8, 0.9], [30, 30, 6, 6, 0.5], [0, 0, 0, 0, 0]], np.float32)
+FRAME = np.zeros((40, 60, 3), np.uint8)
+
+
+def _with(**changes):
+    obs = {"frame": FRAME, "detections": GOOD, "num_detections": 2}
+    obs.update(changes)
+    return {k: v for k, v in obs.items() if v is not ...}
+
+
+def _row(r, c, value):
+    d = GOOD.copy()
+    d[r, c] = value
+    return d
+
+
+MALFORMED = {
+    "not a dict": np.zeros((3, 5)), "None": None, "a list": [GOOD, 2],
+    "no detections": _with(detections=...), "no count": _with(num_detections=...),
+    "text detections": _with(detections=np.array([["a"] * 5] * 3)), "ragged": _with(detections=[[1, 2, 3], [1, 2]]),
+    "object rows": _with(detections=np.array([[None] * 5] * 3, object)), "1-d": _with(detections=GOOD[0]),
+    "4 columns": _with(detections=GOOD[:, :4]), "3-d": _with(detections=GOOD[..., None]),
+    "count -1": _with(num_detections=-1), "count past the rows": _with(num_detections=4),
+    "count 1.5": _with(num_detections=1.5), "count text": _with(num_detections="2"),
+    "count None": _with(num_detections=None), "count list": _with(num_detections=[1, 2]),
+    "count bool": _with(num_detections=True), "count float": _with(num_detections=np.float64(2)),
+    "count huge": _with(num_detections=10**30), "nan": _with(detections=_row(0, 1, np.nan)),
+    "inf": _with(detections=_row(1, 4, np.inf)), "negative width": _with(detections=_row(0, 2, -5)),
+    "zero height": _with(detections=_row(1, 3, 0)),
+}
+BAD_FRAMES = {"no frame": _with(frame=...), "float frame": _with(frame=FRAME.astype(float)),
+              "grey frame": _with(frame=FRAME[..., 0]), "RGBA frame": _with(frame=np.zeros((40, 60, 4), np.uint8)),
+              "empty frame": _with(frame=np.zeros((0, 0, 3), np.uint8))}
+INIT = {"init_ids": np.array([1]), "init_boxes": np.array([[10.0, 10.0, 8.0, 8.0]]), "image_size": (60, 40)}
+
+
+@pytest.mark.parametrize("spec", ["echo", "sort", "iou", "gnn", "bytetrack", "jpda", "gmphd", "lmb:reid=false",
+                                  "lmb", "pf", "ipf"])
+def test_malformed_observations_get_one_clear_error(spec):
+    cases = {**(MALFORMED if spec not in ("pf", "ipf") else {}),
+             **(BAD_FRAMES if trackers.make(spec).needs_frame else {})}
+    for what, obs in cases.items():
+        t = trackers.make(spec)
+        t.reset(INIT)
+        with pytest.raises(ValueError, match="observation|obs_mode") as err:
+            t.update(obs)
+        assert err.type is ValueError, what
+    t = trackers.make(spec)
+    t.reset(INIT)
+    t.update(_with(detections=_row(2, 0, np.nan)))  # rows after num_detections are padding, never read
+
+
+@pytest.mark.parametrize("info", [{"init_ids": [1, 2], "init_boxes": [[0, 0, 5, 5]]},
+                                  {"init_ids": [1.5], "init_boxes": [[0, 0, 5, 5]]},
+                                  {"init_ids": [1], "init_boxes": [[0, 0, np.nan, 5]]},
+                                  {"init_ids": [1], "init_boxes": [[0, 0, -5, 5]]},
+                                  {"init_ids": [1], "init_boxes": "box"}])
+def test_malformed_initial_boxes_get_one_clear_error(info):
+    for spec in ("pf", "ipf", "pcpf"):
+        with pytest.raises(ValueError, match="needs env.reset's info: 'init_ids'"):
+            trackers.make(spec).reset(info)
 
 
 def test_tracks_to_action_pads_and_drops_degenerate_boxes():

@@ -49,6 +49,22 @@ def test_record_episode_statistics_and_time_limit():
     assert info["episode"]["l"] == 7 and info["episode"]["r"] == pytest.approx(sum(rewards))
 
 
+def test_the_episode_metrics_whatever_ends_the_episode():
+    """The env's own limit (the scenario's env.max_steps) gives info["metrics"] on the last step; when a TimeLimit
+    ends the episode first, the same summary is env.unwrapped.metrics.summary()."""
+    ended = {}
+    for how, env in (("own", gym.make("mtt_sim/ClutterStorm-v0", obs_mode="detections", config={"env.max_steps": 7})),
+                     ("time_limit", gym.make("mtt_sim/ClutterStorm-v0", obs_mode="detections", max_episode_steps=7))):
+        obs, _ = env.reset(seed=0)
+        while True:
+            obs, _, term, trunc, info = env.step(echo_policy(obs, env.action_space))
+            if term or trunc:
+                break
+        assert trunc and env.unwrapped.metrics.summary()["num_frames"] == 7
+        ended[how] = info.get("metrics"), env.unwrapped.metrics.summary()
+    assert ended["own"][0] == ended["own"][1] == ended["time_limit"][1] and ended["time_limit"][0] is None
+
+
 def test_flatten_observation_gives_a_vector_in_its_space():
     env = FlattenObservation(gym.make("mtt_sim/ClutterStorm-v0", obs_mode="detections"))
     obs, _ = env.reset(seed=0)

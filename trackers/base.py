@@ -6,6 +6,8 @@ ground truth; hand-initialised trackers get the initial boxes from `reset(info)`
 
 from __future__ import annotations
 
+import difflib
+import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -56,39 +58,128 @@ def covariance_ellipse(centre, cov: np.ndarray, scale2: float, color) -> dict:
 
 
 def detections(obs: Mapping) -> np.ndarray:
-    """The valid (n, 5) rows x, y, w, h, confidence of an observation, checked."""
+    """The valid (n, 5) rows x, y, w, h, confidence of an observation, checked: the one gate between what a tracker
+    is handed and its numpy code, so a malformed observation gets an error that names the problem."""
     if not isinstance(obs, Mapping) or "detections" not in obs or "num_detections" not in obs:
-        raise ValueError("a tracker needs the env's observation: a dict with 'detections' and 'num_detections'")
-    rows = np.asarray(obs["detections"], np.float64)[: int(obs["num_detections"])]
+        raise ValueError("a tracker needs the env's observation: a dict with 'detections' and 'num_detections'"
+                         + (f", got keys {sorted(map(str, obs))}" if isinstance(obs, Mapping) else
+                            f", got {type(obs).__name__}"))
+    try:
+        rows = np.asarray(obs["detections"], np.float64)
+    except (TypeError, ValueError):
+        raise ValueError("observation 'detections' must be an (n, 5) array of numbers") from None
     if rows.ndim != 2 or rows.shape[1] != 5:
         raise ValueError(f"observation 'detections' must have shape (n, 5), got {rows.shape}")
-    if not np.isfinite(rows).all():
-        raise ValueError(f"observation detection row {int(np.flatnonzero(~np.isfinite(rows).all(1))[0])} is not finite")
+    count = np.asarray(obs["num_detections"])
+    if count.ndim != 0 or count.dtype.kind not in "iu" or not 0 <= int(count) <= len(rows):
+        raise ValueError(f"observation 'num_detections' = {obs['num_detections']!r}: must be an integer in "
+                         f"0..{len(rows)} (the rows of 'detections')")
+    rows = rows[: int(count)]
+    bad = ~np.isfinite(rows).all(axis=1)
+    if bad.any():
+        raise ValueError(f"observation detection row {int(np.flatnonzero(bad)[0])} is not finite")
+    small = (rows[:, 2] <= 0) | (rows[:, 3] <= 0)
+    if small.any():
+        raise ValueError(f"observation detection row {int(np.flatnonzero(small)[0])} has a non-positive width or "
+                         f"height: {rows[small][0].tolist()} (boxes are x, y, w, h)")
     return rows
 
 
 def frame_of(obs) -> np.ndarray:
-    """The observation's video frame, or a clear error for a detections-only env."""
-    frame = obs.get("frame") if hasattr(obs, "get") else None
-    if frame is None or np.ndim(frame) != 3 or np.size(frame) == 0:
+    """The observation's video frame, an (H, W, 3) uint8 RGB image, or a clear error."""
+    frame = obs.get("frame") if isinstance(obs, Mapping) else None
+    if frame is None:
         raise ValueError("this tracker reads the video frame: make the env with obs_mode='frame+detections'")
-    return np.asarray(frame)
+    frame = np.asarray(frame)
+    if frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] != 3 or not frame.size:
+        raise ValueError(f"observation 'frame' must be an (H, W, 3) uint8 RGB image, got shape {frame.shape} and dtype "
+                         f"{frame.dtype}")
+    return frame
+
+
+_INTERVAL = re.compile(r"^([\[(])(-inf|[-+0-9.e]+), (inf|[-+0-9.e]+)([\])])$")
+
+
+@dataclass(frozen=True)
+class Param:
+    """A tracker parameter: its default and the values it may take. `allowed` is an interval for a number ("[0, 1]",
+    "(0, inf)": brackets include the end, parentheses exclude it; by default any finite number) or a tuple of
+    choices for a string; a bool takes true or false."""
+
+    default: Any
+    allowed: str | tuple[str, ...] = "(-inf, inf)"
+
+    def __post_init__(self):
+        if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
+            raise ValueError(f"Param allowed={self.allowed!r}: write an interval such as '[0, 1]' or '(0, inf)'")
+
+    def allowed_text(self) -> str:
+        kind = type(self.default)
+        if kind is bool:
+            return "true or false"
+        if isinstance(self.allowed, tuple):
+            return ", ".join(map(repr, self.allowed))
+        return f"{'an integer' if kind is int else 'a number'} in {self.allowed}"
+
+    def check(self, tracker: str, key: str, value):
+        """`value` converted to the default's type and inside the allowed values, or a ValueError saying which are."""
+        out = _coerce(value, type(self.default))
+        if out is None or not self._allows(out):
+            raise ValueError(f"tracker {tracker!r}: parameter {key}={value!r}: allowed: {self.allowed_text()} "
+                             f"(default {self.default!r})")
+        return out
+
+    def _allows(self, value) -> bool:
+        if isinstance(value, bool):
+            return True
+        if isinstance(self.allowed, tuple):
+            return value in self.allowed
+        opening, lo, hi, closing = _INTERVAL.match(self.allowed).groups()
+        lo, hi = float(lo), float(hi)
+        return (lo < value or (opening == "[" and value == lo)) and (value < hi or (closing == "]" and value == hi))
+
+
+def _coerce(value, kind):
+    """`value` as a `kind` (bool, int, float or str; numpy numbers and text such as "3" or "true" too), or None."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if kind is bool:
+        if isinstance(value, str) and value.lower() in ("true", "false"):
+            return value.lower() == "true"
+        return value if isinstance(value, bool) else None
+    if kind is str:
+        return value if isinstance(value, str) else None
+    if isinstance(value, bool):
+        return None
+    if kind is int and isinstance(value, int):
+        return value
+    try:
+        number = float(value)
+        out = kind(number) if kind is int else number
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if not np.isfinite(number) or (kind is int and out != number):
+        return None
+    return out
 
 
 class Tracker:
-    """Base class: subclasses set `name`, `description`, `defaults` and implement `reset` and `update`."""
+    """Base class: subclasses set `name`, `description`, `parameters` (name -> Param) and implement `reset` and
+    `update`. Parameters are checked against their allowed values when the tracker is made."""
 
     name = "tracker"
     description = ""
-    defaults: dict[str, Any] = {}
+    parameters: dict[str, Param] = {}
     needs_frame = False  # True for trackers that read the video frame (appearance models)
 
     def __init__(self, **params):
-        unknown = sorted(set(params) - set(self.defaults))
+        unknown = sorted(set(params) - set(self.parameters))
         if unknown:
-            raise ValueError(f"tracker {self.name!r}: unknown parameter {unknown[0]!r}; allowed: "
-                             + ", ".join(f"{k} (default {v!r})" for k, v in self.defaults.items()))
-        self.params = {k: _coerce(self.name, k, params.get(k, v), v) for k, v in self.defaults.items()}
+            near = difflib.get_close_matches(unknown[0], self.parameters, n=1)
+            raise ValueError(f"tracker {self.name!r}: unknown parameter {unknown[0]!r}"
+                             + (f" (did you mean {near[0]!r}?)" if near else "") + "; allowed: "
+                             + ", ".join(f"{k} (default {p.default!r})" for k, p in self.parameters.items()))
+        self.params = {k: p.check(self.name, k, params.get(k, p.default)) for k, p in self.parameters.items()}
 
     def reset(self, info: Mapping | None = None) -> None:
         """Start a new episode; `info` is what env.reset returned."""
@@ -101,28 +192,6 @@ class Tracker:
         axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h) or "text" (xy, text), and an
         optional RGB "color". May be empty."""
         return []
-
-
-def _coerce(tracker: str, key: str, value, default):
-    """A parameter value converted to the type of its default, or a clear error."""
-    kind = type(default)
-    if kind is bool:
-        if isinstance(value, str) and value.lower() in ("true", "false"):
-            return value.lower() == "true"
-        if isinstance(value, bool):
-            return value
-    elif kind in (int, float):
-        try:
-            out = kind(value)
-            if kind is int and float(value) != out:
-                raise ValueError
-            if np.isfinite(out):
-                return out
-        except (TypeError, ValueError):
-            pass
-    elif kind is str and isinstance(value, str):
-        return value
-    raise ValueError(f"tracker {tracker!r}: parameter {key}={value!r} must be a {kind.__name__}")
 
 
 REGISTRY: dict[str, Callable[..., Tracker]] = {}

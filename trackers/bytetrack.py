@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import assign, iou_matrix
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
 from .trackbook import CONFIRMED, LOST, TENTATIVE, TrackBook
 
@@ -23,8 +23,9 @@ class ByteTrack(Tracker):
 
     name = "bytetrack"
     description = "ByteTrack (Zhang et al. 2022): two-stage association with high- and low-confidence detections"
-    defaults = {"track_thresh": 0.5, "low_thresh": 0.1, "new_track_thresh": 0.6, "match_thresh": 0.8,
-                "second_match_thresh": 0.5, "unconfirmed_match_thresh": 0.7, "track_buffer": 30}
+    parameters = {"track_thresh": Param(0.5), "low_thresh": Param(0.1), "new_track_thresh": Param(0.6),
+                  "match_thresh": Param(0.8, "[0, 1]"), "second_match_thresh": Param(0.5, "[0, 1]"),
+                  "unconfirmed_match_thresh": Param(0.7, "[0, 1]"), "track_buffer": Param(30, "[0, inf)")}
 
     def reset(self, info=None):
         self.book = TrackBook(KalmanBank(box_model()))

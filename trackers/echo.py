@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 
 
 @register
@@ -14,7 +14,7 @@ class Echo(Tracker):
 
     name = "echo"
     description = "Floor baseline: each frame's detections as tracks, numbered afresh every frame"
-    defaults = {"min_confidence": 0.0}
+    parameters = {"min_confidence": Param(0.0)}
 
     def update(self, obs) -> Tracks:
         dets = detections(obs)

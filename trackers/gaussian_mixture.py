@@ -11,11 +11,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .base import Param
+
 DIM, MEAS = 8, 4
 # the model parameters the LMB and GM-PHD trackers share; noise values chosen on mot17_like seed 100 (not one
 # of the experiments' seeds 0..9)
-MODEL_DEFAULTS = {"survival": 0.98, "detection": 0.75, "clutter_rate": 5.0, "gate": 0.99,
-                  "measurement_noise": 0.15, "process_noise": 0.01}
+MODEL_PARAMETERS = {"survival": Param(0.98, "(0, 1]"), "detection": Param(0.75, "(0, 1]"),
+                    "clutter_rate": Param(5.0, "(0, inf)"), "gate": Param(0.99, "(0, 1)"),
+                    "measurement_noise": Param(0.15, "(0, inf)"), "process_noise": Param(0.01, "(0, inf)")}
 F = np.eye(DIM) + np.eye(DIM, k=MEAS)
 H = np.eye(MEAS, DIM)
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from . import gaussian_mixture as gm
 from .assignment import chi2_gate
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 
 
 @register
@@ -26,8 +26,9 @@ class GaussianMixturePhd(Tracker):
 
     name = "gmphd"
     description = "GM-PHD filter (Vo and Ma 2006), measurement-driven birth, labels tagged through updates"
-    defaults = {**gm.MODEL_DEFAULTS, "birth_weight": 0.3, "prune": 1e-4, "merge": 4.0, "max_components": 200,
-                "extract": 0.5}
+    parameters = {**gm.MODEL_PARAMETERS, "birth_weight": Param(0.3, "(0, inf)"), "prune": Param(1e-4, "[0, 1)"),
+                  "merge": Param(4.0, "[0, inf)"), "max_components": Param(200, "[1, inf)"),
+                  "extract": Param(0.5, "(0, inf)")}
 
     def reset(self, info=None):
         size = (info or {}).get("image_size")

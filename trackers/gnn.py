@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import assign, chi2_gate
-from .base import Tracker, Tracks, covariance_ellipse, detections, register
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections, register
 from .kalman import KalmanBank, point_model
 from .trackbook import CONFIRMED, TENTATIVE, TrackBook
 
@@ -21,8 +21,9 @@ class Gnn(Tracker):
 
     name = "gnn"
     description = "Global nearest neighbour: Kalman centres, chi-square gating, Hungarian on Mahalanobis distance"
-    defaults = {"gate_probability": 0.99, "min_hits": 3, "max_age": 5, "accel_sigma": 0.5, "meas_sigma": 2.0,
-                "coast": False, "min_confidence": 0.0}
+    parameters = {"gate_probability": Param(0.99, "(0, 1)"), "min_hits": Param(3, "[0, inf)"),
+                  "max_age": Param(5, "[0, inf)"), "accel_sigma": Param(0.5, "[0, inf)"),
+                  "meas_sigma": Param(2.0, "(0, inf)"), "coast": Param(False), "min_confidence": Param(0.0)}
 
     def reset(self, info=None):
         p = self.params

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import iou_matrix
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 from .trackbook import TrackBook
 
 
@@ -19,7 +19,8 @@ class IouTracker(Tracker):
 
     name = "iou"
     description = "IOU tracker (Bochinski et al. 2017): greedy IoU linking with sigma_l, sigma_h, sigma_iou, t_min"
-    defaults = {"sigma_l": 0.0, "sigma_h": 0.5, "sigma_iou": 0.5, "t_min": 2}
+    parameters = {"sigma_l": Param(0.0), "sigma_h": Param(0.5), "sigma_iou": Param(0.5, "[0, 1]"),
+                  "t_min": Param(2, "[1, inf)")}
 
     def reset(self, info=None):
         self.book = TrackBook()

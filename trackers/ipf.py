@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import bhattacharyya, histograms, hs_bins
-from .base import Tracker, Tracks, frame_of, register
+from .base import Param, Tracker, Tracks, frame_of, register
 from .particle import crop_around, initial_targets
 
 
@@ -45,8 +45,9 @@ class InteractiveParticleFilter(Tracker):
 
     name = "ipf"
     description = "Seed 002: interactive particle filter through full occlusion (Liu et al. 2011; hand-initialised)"
-    defaults = {"particles": 100, "conflict_ratio": 0.75, "sigma2": 0.045, "h_levels": 16, "s_levels": 16,
-                "interactive": True, "samples": 256, "seed": 0}
+    parameters = {"particles": Param(100, "[1, 100000]"), "conflict_ratio": Param(0.75, "(0, 1]"),
+                  "sigma2": Param(0.045, "(0, inf)"), "h_levels": Param(16, "[2, 180]"), "s_levels": Param(16, "[2, 256]"),
+                  "interactive": Param(True), "samples": Param(256, "[0, inf)"), "seed": Param(0, "[0, inf)")}
     needs_frame = True
 
     def reset(self, info=None):
@@ -116,8 +117,9 @@ class PathConsistencyParticleFilter(InteractiveParticleFilter):
 
     name = "pcpf"
     description = "Seed 002's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
-    defaults = {**InteractiveParticleFilter.defaults, "particles": 200, "interactive": False,
-                "occluded_distance": 0.3, "velocity_gain": 0.3}
+    parameters = {**InteractiveParticleFilter.parameters, "particles": Param(200, "[1, 100000]"),
+                  "interactive": Param(False), "occluded_distance": Param(0.3, "[0, 1]"),
+                  "velocity_gain": Param(0.3, "[0, 1]")}
 
     def reset(self, info=None):
         super().reset(info)

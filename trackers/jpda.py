@@ -16,7 +16,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .assignment import chi2_gate, murty
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 from .kalman import KalmanBank, point_model
 
 
@@ -150,16 +150,12 @@ class Jpda(Tracker):
 
     name = "jpda"
     description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
-    defaults = {"pd": 0.9, "clutter_density": 1e-5, "gate_probability": 0.99, "k": 0, "vanish_frames": 3,
-                "revive_frames": 5, "accel_sigma": 0.5, "meas_sigma": 4.0, "min_confidence": 0.0,
-                "situations": True, "occlusion_velocity": "zero", "speed_sigma0": 2.0, "min_hits": 1,
-                "merge_frames": 40}
-
-    def __init__(self, **params):
-        super().__init__(**params)
-        if self.params["occlusion_velocity"] not in ("keep", "zero"):
-            raise ValueError(f"tracker {self.name!r}: occlusion_velocity={self.params['occlusion_velocity']!r}: "
-                             "allowed: 'keep', 'zero'")
+    parameters = {"pd": Param(0.9, "(0, 1)"), "clutter_density": Param(1e-5, "(0, inf)"),
+                  "gate_probability": Param(0.99, "(0, 1)"), "k": Param(0, "[0, inf)"), "vanish_frames": Param(3, "[1, inf)"),
+                  "revive_frames": Param(5, "[0, inf)"), "accel_sigma": Param(0.5, "[0, inf)"),
+                  "meas_sigma": Param(4.0, "(0, inf)"), "min_confidence": Param(0.0), "situations": Param(True),
+                  "occlusion_velocity": Param("zero", ("keep", "zero")), "speed_sigma0": Param(2.0, "(0, inf)"),
+                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)")}
 
     def reset(self, info=None):
         p = self.params
@@ -376,7 +372,7 @@ class JpdaExact(Jpda):
 
     name = "jpda_exact"
     description = "Traditional JPDA: every joint event enumerated (clusters capped at max_exact_targets targets)"
-    defaults = {**Jpda.defaults, "max_exact_targets": 8, "max_events": 5000}
+    parameters = {**Jpda.parameters, "max_exact_targets": Param(8, "[0, 20]"), "max_events": Param(5000, "[1, inf)")}
 
     def _k(self, n_targets: int, n_measurements: int) -> int | None:
         return None if n_targets <= self.params["max_exact_targets"] else self.params["max_events"]

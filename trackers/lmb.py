@@ -8,7 +8,7 @@ import numpy as np
 from . import gaussian_mixture as gm
 from . import reid
 from .assignment import chi2_gate, murty
-from .base import Tracker, Tracks, covariance_ellipse, detections, frame_of, register
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections, frame_of, register
 from .jpda import clusters
 
 EPS = 1e-12
@@ -118,10 +118,13 @@ class LabelledMultiBernoulli(Tracker):
 
     name = "lmb"
     description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
-    defaults = {**gm.MODEL_DEFAULTS, "hypotheses": 15, "birth": "adaptive", "birth_max": 0.6, "fixed_births": 16,
-                "fixed_birth_r": 0.03, "extract": 0.5, "prune": 1e-3, "max_components": 4, "use_low_confidence": True,
-                "low_confidence": 0.5, "reid": True, "reid_confidence": 0.7,
-                "reid_threshold": 5.0, "pool_per_target": 10, "pool_every": 10}
+    parameters = {**gm.MODEL_PARAMETERS, "hypotheses": Param(15, "[1, inf)"),
+                  "birth": Param("adaptive", ("adaptive", "fixed")), "birth_max": Param(0.6, "(0, 1)"),
+                  "fixed_births": Param(16, "[1, inf)"), "fixed_birth_r": Param(0.03, "(0, 1)"),
+                  "extract": Param(0.5, "(0, 1)"), "prune": Param(1e-3, "[0, 1)"), "max_components": Param(4, "[1, inf)"),
+                  "use_low_confidence": Param(True), "low_confidence": Param(0.5), "reid": Param(True),
+                  "reid_confidence": Param(0.7), "reid_threshold": Param(5.0, "(0, inf)"),
+                  "pool_per_target": Param(10, "[1, inf)"), "pool_every": Param(10, "[1, inf)")}
 
     @property
     def needs_frame(self) -> bool:
@@ -129,8 +132,6 @@ class LabelledMultiBernoulli(Tracker):
 
     def reset(self, info=None):
         p = self.params
-        if p["birth"] not in ("adaptive", "fixed"):
-            raise ValueError(f"lmb: birth={p['birth']!r}: allowed values: 'adaptive', 'fixed'")
         size = (info or {}).get("image_size")
         if size is None or min(size) <= 0:
             raise ValueError("lmb needs the image size (clutter density, border births): pass env.reset's info")

@@ -3,18 +3,29 @@ descriptor, with a template update guarded against occlusion."""
 
 from __future__ import annotations
 
+from typing import Mapping
+
 import numpy as np
 
 from .appearance import bhattacharyya, gradient_descriptors, histograms, orientation_maps, rgb_bins
-from .base import Tracker, Tracks, frame_of, register
+from .base import Param, Tracker, Tracks, frame_of, register
 
 
 def initial_targets(info) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(ids, centres (k, 2), integer sizes (k, 2), at least 4 px) of the boxes env.reset gives hand-initialised trackers."""
-    info = info or {}
-    boxes = np.asarray(info.get("init_boxes", np.zeros((0, 4))), float).reshape(-1, 4)
+    """(ids, centres (k, 2), integer sizes (k, 2), at least 4 px) of the boxes env.reset gives hand-initialised trackers,
+    checked: `init_ids` (k,) integers and `init_boxes` (k, 4) finite x, y, w, h with w, h > 0."""
+    info = info if isinstance(info, Mapping) else {}
+    try:
+        ids = np.asarray(info.get("init_ids", np.zeros(0, np.int64)))
+        boxes = np.asarray(info.get("init_boxes", np.zeros((0, 4))), float)
+    except (TypeError, ValueError):
+        boxes = ids = np.zeros(1)  # fails the checks below
+    if ids.ndim != 1 or ids.dtype.kind not in "iu" or boxes.shape != (len(ids), 4) or not np.isfinite(boxes).all() \
+            or (boxes[:, 2:] <= 0).any():
+        raise ValueError("a hand-initialised tracker needs env.reset's info: 'init_ids' (k,) integers and 'init_boxes' "
+                         "(k, 4) finite boxes x, y, w, h with positive sizes")
     sizes = np.maximum(np.round(boxes[:, 2:]), 4).astype(int)
-    return np.asarray(info.get("init_ids", []), np.int64), boxes[:, :2] + boxes[:, 2:] / 2, sizes
+    return ids.astype(np.int64), boxes[:, :2] + boxes[:, 2:] / 2, sizes
 
 
 def crop_around(frame: np.ndarray, centres: np.ndarray, size) -> tuple[np.ndarray, np.ndarray]:
@@ -50,8 +61,10 @@ class ColourTextureParticleFilter(Tracker):
 
     name = "pf"
     description = "Seed 001: colour + gradient-orientation particle filter with template update (hand-initialised)"
-    defaults = {"particles": 60, "alpha": 0.6, "lam": 20.0, "mu": 10.0, "beta": 0.9, "update_threshold": 0.3,
-                "pos_sigma": 3.0, "vel_sigma": 1.0, "levels": 16, "seed": 0}
+    parameters = {"particles": Param(60, "[1, 100000]"), "alpha": Param(0.6, "[0, 1]"), "lam": Param(20.0, "(0, inf)"),
+                  "mu": Param(10.0, "(0, inf)"), "beta": Param(0.9, "[0, 1]"), "update_threshold": Param(0.3, "[0, 1]"),
+                  "pos_sigma": Param(3.0, "[0, inf)"), "vel_sigma": Param(1.0, "[0, inf)"), "levels": Param(16, "[2, 64]"),
+                  "seed": Param(0, "[0, inf)")}
     needs_frame = True
 
     def reset(self, info=None):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from .assignment import assign, iou_matrix
-from .base import Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, register
 from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
 from .trackbook import TrackBook
 
@@ -18,7 +18,8 @@ class Sort(Tracker):
 
     name = "sort"
     description = "SORT (Bewley et al. 2016): Kalman boxes + Hungarian IoU matching, min_hits, max_age"
-    defaults = {"max_age": 1, "min_hits": 3, "iou_threshold": 0.3, "min_confidence": 0.0}
+    parameters = {"max_age": Param(1, "[0, inf)"), "min_hits": Param(3, "[0, inf)"), "iou_threshold": Param(0.3, "[0, 1]"),
+                  "min_confidence": Param(0.0)}
 
     def reset(self, info=None):
         self.book = TrackBook(KalmanBank(box_model()))
