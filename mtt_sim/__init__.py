@@ -1,23 +1,34 @@
 """mtt-sim: a Gymnasium environment for video multi-target tracking.
 
-Importing the package registers one environment id per shipped scenario, ``mtt_sim/<Name>-v0``.
+Importing the package registers one environment id per shipped scenario, ``mtt_sim/<Name>-v0``. The env itself
+(and the simulator behind it) is imported on first use, so the command line answers a mistyped argument at once.
 """
+
+from importlib import metadata
 
 from gymnasium.envs.registration import register, registry
 
-from .env import ActionError, TrackingEnv
-from .scenario import ConfigError, Scenario, available, load, load_raw
+from .scenario import ConfigError, Scenario, available, load, shipped_names
 
-__version__ = "0.1.0"
+__version__ = metadata.version("mtt-sim")
 
 
 def env_ids() -> dict[str, str]:
     """Shipped scenario keys mapped to their registered env ids."""
-    return {key: f"mtt_sim/{load_raw(key)[0].get('name', 'Custom')}-v0" for key in available()}
+    return {key: f"mtt_sim/{name}-v0" for key, name in shipped_names().items()}
 
 
 for _key, _id in env_ids().items():
     if _id not in registry:
         register(id=_id, entry_point="mtt_sim.env:TrackingEnv", kwargs={"scenario": _key})
+
+
+def __getattr__(name: str):
+    if name in ("TrackingEnv", "ActionError"):
+        from . import env
+
+        return getattr(env, name)
+    raise AttributeError(f"module 'mtt_sim' has no attribute {name!r}")
+
 
 __all__ = ["TrackingEnv", "ActionError", "ConfigError", "Scenario", "available", "load", "env_ids"]

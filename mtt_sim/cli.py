@@ -1,16 +1,146 @@
-"""The `mtt-sim` command: list scenarios, run an episode, bench and sweep trackers, measure speed, print the config."""
+"""The `mtt-sim` command: list scenarios and trackers, run an episode, bench and sweep trackers, measure speed, print
+the configuration, learn the re-identification metric, write and score MOTChallenge files.
+
+Every argument is checked before any work starts; a bad one gets one line naming the argument, the value and what is
+allowed, and exit status 2. The heavy modules (the simulator, the trackers) are imported only once the arguments hold.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
+import os
+import shlex
+import signal
 import sys
 import tomllib
+from pathlib import Path
 
-from . import experiment, perf, scenario
+from . import __version__, scenario
 
-SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW", "Frag",
-                "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
+SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
+                "Frag", "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
+INTERRUPTED = 130  # the shell's status for a command stopped by Ctrl-C (SIGTERM is treated the same way)
+
+
+class UsageError(Exception):
+    """An argument that passed parsing but cannot be used (a file that exists, an override the scenario rejects)."""
+
+    def __init__(self, argument: str, message: str):
+        super().__init__(f"argument {argument}: {message}")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: the problem and where to read more, not the whole usage block."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+# ------------------------------------------------------------------ argument types (each raises with what is allowed)
+
+def _integer(lo: int, hi: int | None = None):
+    allowed = f"an integer >= {lo}" if hi is None else f"an integer in {lo}..{hi}"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {allowed}, got {text!r}") from None
+        if value < lo or (hi is not None and value > hi):
+            raise argparse.ArgumentTypeError(f"must be {allowed}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value <= 1:
+        raise argparse.ArgumentTypeError(f"must be a number in (0, 1], got {text!r}")
+    return value
+
+
+def parse_seeds(text: str) -> list[int]:
+    """Seeds from a count ("5": 0..4), a list ("3,7,11"), a range ("100-199") or a list of both ("0-4,9")."""
+    text = text.strip()
+    try:
+        if text.isdigit():
+            count = int(text)
+            if count < 1:
+                raise ValueError
+            return list(range(count))
+        seeds = []
+        for item in text.split(","):
+            first, sep, last = item.strip().partition("-")
+            lo, hi = int(first), int(last) if sep else int(first)
+            if lo < 0 or hi < lo:
+                raise ValueError
+            seeds += range(lo, hi + 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a count of at least 1 (5: seeds 0..4), a list (3,7,11) or "
+                                         "a range (100-199) of seeds >= 0") from None
+    if len(set(seeds)) != len(seeds):
+        raise argparse.ArgumentTypeError(f"{text!r}: a seed is given twice")
+    return seeds
+
+
+def _scenario(text: str) -> str:
+    try:
+        return str(scenario.resolve(text))
+    except scenario.ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _scenarios(text: str) -> list[str]:
+    keys = [_scenario(t) for t in text.split(",") if t.strip()]
+    if not keys or len(set(keys)) != len(keys):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected distinct comma-separated scenarios")
+    return keys
+
+
+def _tracker_specs(text: str) -> list[str]:
+    import trackers
+
+    specs = trackers.split_specs(text)
+    if not specs or len(set(specs)) != len(specs):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected distinct tracker specs, e.g. sort,iou or "
+                                         "'sort:min_hits=1,max_age=5;iou'")
+    canonical = []
+    for spec in specs:
+        try:
+            name = trackers.make(spec).name
+        except ValueError as err:
+            raise argparse.ArgumentTypeError(str(err)) from None
+        canonical.append(name + spec[len(spec.partition(":")[0]):])  # the name as registered, the parameters as typed
+    return canonical
+
+
+def _tracker_spec(text: str) -> str:
+    specs = _tracker_specs(text)
+    if len(specs) != 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: one tracker spec, e.g. 'sort:max_age=3,min_hits=1'")
+    return specs[0]
+
+
+def _metrics(text: str) -> list[str]:
+    from .metrics import METRICS, PER_TARGET
+
+    names = {m.lower(): m for m in (*METRICS, *PER_TARGET)}
+    out = []
+    for typed in filter(None, (t.strip() for t in text.split(","))):
+        if typed.lower() not in names:
+            import difflib
+
+            near = difflib.get_close_matches(typed.lower(), names, n=1)
+            raise argparse.ArgumentTypeError(f"unknown metric {typed!r}" + (f" (did you mean {names[near[0]]!r}?)"
+                                             if near else "") + f"; available: {', '.join(names.values())}")
+        out.append(names[typed.lower()])
+    return out
 
 
 def parse_overrides(items: list[str]) -> dict:
@@ -19,7 +149,7 @@ def parse_overrides(items: list[str]) -> dict:
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key:
-            raise scenario.ConfigError(f"--config {item!r}: expected key=value, e.g. sensor.clutter_rate=5")
+            raise UsageError("--config", f"{item!r}: expected key=value, e.g. sensor.clutter_rate=5")
         out[key] = _toml_value(value)
     return out
 
@@ -31,9 +161,59 @@ def _toml_value(text: str):
         return text
 
 
+# ------------------------------------------------------------------ checks of what the arguments name together
+
+def _loaded(scenarios: list[str], overrides: dict, argument: str = "--config", configs=({},)) -> None:
+    """Every scenario loads with the overrides (and each swept value), or a UsageError names the problem."""
+    for sc in scenarios:
+        for extra in configs:
+            try:
+                scenario.load(sc, {**overrides, **extra})
+            except scenario.ConfigError as err:
+                raise UsageError(argument, str(err)) from None
+
+
+def _output(path: str | None, force: bool, argument: str, suffixes: tuple[str, ...]) -> Path | None:
+    """An output file that can be written: a known suffix, an existing writable folder, not there yet unless --force."""
+    if path is None:
+        return None
+    out = Path(path)
+    if out.suffix.lower() not in suffixes:
+        raise UsageError(argument, f"{path!r}: the file name must end in {' or '.join(suffixes)}")
+    if out.is_dir():
+        raise UsageError(argument, f"{path!r} is a folder; give a file name")
+    if out.exists() and not force:
+        raise UsageError(argument, f"{path!r} exists; add --force to replace it")
+    _writable_folder(out.parent, argument, path)
+    return out
+
+
+def _writable_folder(folder: Path, argument: str, path: str) -> None:
+    if not folder.is_dir():
+        raise UsageError(argument, f"{path!r}: folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise UsageError(argument, f"{path!r}: folder {str(folder)!r} is not writable")
+
+
+def _require(module: str, argument: str, extra: str) -> None:
+    try:
+        found = importlib.util.find_spec(module) is not None
+    except ValueError:  # a module set to None in sys.modules
+        found = False
+    if not found:
+        raise UsageError(argument, f"needs {module}: pip install 'mtt-sim[{extra}]'")
+
+
+# ------------------------------------------------------------------ commands
+
 def cmd_run(args) -> int:
-    record = experiment.run_episode(args.scenario, args.tracker, args.seed, parse_overrides(args.config),
-                                    video=args.video, steps=args.steps or None)
+    overrides = parse_overrides(args.config)
+    _loaded([args.scenario], overrides)
+    video = _output(args.video, args.force, "--video", (".mp4", ".avi"))
+    from . import experiment
+
+    record = experiment.run_episode(args.scenario, args.tracker, args.seed, overrides, video=args.video,
+                                    steps=args.steps, progress=True)
     summary = {"scenario": args.scenario, "tracker": args.tracker, "seed": args.seed,
                **{k: record["metrics"][k] for k in SUMMARY_KEYS},
                "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
@@ -42,92 +222,180 @@ def cmd_run(args) -> int:
         return 0
     for k, v in summary.items():
         print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
-    if args.video:
-        print(f"{'video':12s} {args.video}")
+    if video:
+        print(f"{'video':12s} {video}" + (" (replaced)" if args.force else ""))
     return 0
-
-
-def _grid_output(args, records, tables):
-    if args.out:
-        experiment.write_records(records, args.out)
-    print("\n\n".join(tables))
-    if args.out:
-        print(f"\nrecords: {args.out}")
 
 
 def cmd_bench(args) -> int:
-    records = experiment.run_grid(args.trackers.split(","), args.scenarios.split(","), args.seeds,
-                                  config=parse_overrides(args.config), workers=args.workers, progress=True,
-                                  backend=args.backend, address=args.address)
-    title = args.scenarios if args.by == "target" else ""
-    _grid_output(args, records, [experiment.markdown(experiment.summarize(records, m, by=args.by), title)
-                                 for m in args.metric.split(",")])
-    return 0
+    overrides = parse_overrides(args.config)
+    _loaded(args.scenarios, overrides)
+    if args.by == "target" and set(args.metric) - {"CentreError", "Coverage"}:
+        raise UsageError("--metric", "with --by target: CentreError or Coverage (per-target metrics)")
+    title = ",".join(args.scenarios) if args.by == "target" else ""
+    return _grid(args, args.scenarios, overrides, None, lambda records, metric: [
+        _table(records, metric, args.by, title)])
 
 
 def cmd_sweep(args) -> int:
     key, sep, values = args.param.partition("=")
-    if not sep or not values:
-        raise scenario.ConfigError(f"--param {args.param!r}: expected key=v1,v2,..., e.g. sensor.clutter_rate=0,5,10")
+    if not sep or not key or not values:
+        raise UsageError("--param", f"{args.param!r}: expected key=v1,v2,..., e.g. sensor.clutter_rate=0,5,10")
     values = [_toml_value(v) for v in values.split(",")]
-    records = experiment.run_grid(args.trackers.split(","), [args.scenario], args.seeds,
-                                  config=parse_overrides(args.config), configs=[{key: v} for v in values],
-                                  workers=args.workers, progress=True, backend=args.backend, address=args.address)
-    tables = []
-    for metric in args.metric.split(","):
+    overrides = parse_overrides(args.config)
+    _loaded([args.scenario], overrides)
+    _loaded([args.scenario], overrides, "--param", [{key: v} for v in values])
+    if args.plot:
+        _require("matplotlib", "--plot", "plot")
+        _output(args.plot, args.force, "--plot", (".png", ".pdf", ".svg"))
+
+    def tables(records, metric):
+        from . import experiment
+
         rows = experiment.summarize(records, metric, by="config")
         for r in rows:
             r["column"] = f"{key.split('.')[-1]}={json.loads(r['column'])[key]}"
-        tables.append(experiment.markdown(rows, f"{args.scenario}, sweeping {key}"))
-    _grid_output(args, records, tables)
-    if args.plot:
-        experiment.sweep_plot(rows, key, values, args.plot)
-        print(f"plot: {args.plot} ({metric})")
-    return 0
+        if args.plot and metric == args.metric[-1] and rows:
+            experiment.sweep_plot(rows, key, values, args.plot)
+            print(f"plot: {args.plot} ({metric})")
+        return [experiment.markdown(rows, f"{args.scenario}, sweeping {key}")] if rows else []
+
+    return _grid(args, [args.scenario], overrides, [{key: v} for v in values], tables)
+
+
+def _table(records, metric, by, title) -> str:
+    from . import experiment
+
+    rows = experiment.summarize(records, metric, by=by)
+    return experiment.markdown(rows, title) if rows else ""
+
+
+def _grid(args, scenarios: list[str], overrides: dict, configs, tables) -> int:
+    """Run a bench or sweep grid: records written as they finish, tables and a list of failed episodes at the end,
+    and on Ctrl-C or SIGTERM the workers stopped and what finished kept. Exit status: 0, 1 if an episode failed,
+    130 if interrupted."""
+    out = _output(args.out, args.force, "--out", (".csv", ".json"))
+    if args.backend == "ray":
+        _require("ray", "--backend", "ray")
+    from . import experiment
+
+    finished = []
+    record_file = experiment.RecordFile(out) if out else None
+
+    def keep(record):
+        finished.append(record)
+        if record_file:
+            record_file.append(record)
+
+    interrupted = False
+    try:
+        records = experiment.run_grid(args.trackers, scenarios, args.seeds, config=overrides, configs=configs,
+                                      workers=args.workers, progress=True, backend=args.backend, address=args.address,
+                                      on_record=keep)
+    except KeyboardInterrupt:
+        records, interrupted = finished, True
+    finally:
+        if record_file:
+            record_file.close()
+    if out and not interrupted:
+        experiment.write_records(records, out)  # again, in grid order
+    done = [r for r in records if r is not None]
+    print("\n\n".join(t for m in args.metric for t in tables(done, m) if t))
+    failed = [r for r in done if r["error"]]
+    if failed:
+        print(f"\n{len(failed)} of {len(done)} episodes failed:")
+        for r in failed:
+            again = ["mtt-sim", "run", r["scenario"], "--tracker", r["tracker"], "--seed", str(r["seed"])]
+            config = [f"{k}={json.dumps(v)}" for k, v in r["config"].items()]
+            print(f"  {r['tracker']} on {r['scenario']} seed {r['seed']}: {r['error']}\n"
+                  f"    again: {shlex.join(again + (['--config', *config] if config else []))}")
+    if out:
+        print(f"\nrecords: {out}" + (" (replaced)" if args.force else ""))
+    if interrupted:
+        print(f"mtt-sim {args.command}: interrupted; {len(done)} of {_grid_size(args, scenarios, configs)} episodes "
+              "finished" + (f", their records in {out}" if out else ""), file=sys.stderr)
+        return INTERRUPTED
+    return 1 if failed else 0
+
+
+def _grid_size(args, scenarios, configs) -> int:
+    return len(args.trackers) * len(scenarios) * len(args.seeds) * len(configs or [{}])
 
 
 def cmd_list(args) -> int:
     from . import env_ids
+
     ids = env_ids()
     for key, desc in scenario.available().items():
         print(f"{key:14s} {ids[key]:26s} {desc}")
     return 0
 
 
+def cmd_trackers(args) -> int:
+    import trackers
+
+    for name, cls in sorted(trackers.base.REGISTRY.items()):
+        print(f"{name}: {cls.description}")
+        for key, param in cls.parameters.items():
+            print(f"    {key + '=' + repr(param.default):34s} {param.allowed_text()}")
+    return 0
+
+
 def cmd_perf(args) -> int:
-    print(perf.report(perf.measure(repeats=args.repeats, steps=args.steps)))
-    print()
-    print(perf.report_metrics(perf.measure_metrics(repeats=args.repeats)))
-    print()
-    print(perf.report_metrics_memory(perf.measure_metrics_memory(repeats=args.repeats)))
-    print()
-    print(perf.report_jpda(perf.measure_jpda(repeats=args.repeats)))
-    print()
-    print(perf.report_lmb(perf.measure_lmb(repeats=args.repeats)))
-    print()
-    print(perf.report_pf(perf.measure_pf(repeats=args.repeats)))
+    from tqdm import tqdm
+
+    from . import perf
+
+    sections = [("env", lambda: perf.report(perf.measure(repeats=args.repeats, steps=args.steps))),
+                ("metrics", lambda: perf.report_metrics(perf.measure_metrics(repeats=args.repeats))),
+                ("metrics memory", lambda: perf.report_metrics_memory(perf.measure_metrics_memory(repeats=args.repeats))),
+                ("jpda", lambda: perf.report_jpda(perf.measure_jpda(repeats=args.repeats))),
+                ("lmb", lambda: perf.report_lmb(perf.measure_lmb(repeats=args.repeats))),
+                ("particle filters", lambda: perf.report_pf(perf.measure_pf(repeats=args.repeats)))]
+    with tqdm(sections, unit="section", leave=False) as bar:
+        for name, measure in bar:
+            bar.set_description(f"measuring {name}")
+            bar.write(measure() + "\n")
     return 0
 
 
 def cmd_learn_reid(args) -> int:
+    import trackers.reid
+
+    out = trackers.reid.METRIC_FILE if args.install else Path(args.out)
+    _output(str(out), args.force or args.install, "--out", (".npz",))
     from . import learn_reid
-    summary = learn_reid.learn(args.scenario, range(args.first_seed, args.first_seed + args.seeds), args.frames,
-                               args.every, args.dims, args.out)
+
+    summary = learn_reid.learn(out, args.scenario, args.seeds, args.frames, args.every, args.dims, progress=True)
     for k, v in summary.items():
         print(f"{k:12s} {v}")
+    if not args.install:
+        print(f"use it with --tracker 'lmb:reid_metric={out}' (or relearn with --install to replace the shipped one)")
     return 0
 
 
 def cmd_export(args) -> int:
+    overrides = parse_overrides(args.config)
+    _loaded([args.scenario], overrides)
+    out = Path(args.out)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
+        raise UsageError("--out", f"{args.out!r} exists and is not empty; add --force to replace its sequence")
+    _writable_folder(out if out.is_dir() else out.parent, "--out", args.out)
     from . import motchallenge
-    summary = motchallenge.export(args.scenario, args.out, args.seed, args.steps or None, parse_overrides(args.config))
+
+    summary = motchallenge.export(args.scenario, out, args.seed, args.steps, overrides, progress=True)
     for k, v in summary.items():
         print(f"{k:12s} {v}")
     return 0
 
 
 def cmd_eval(args) -> int:
+    for argument, path, kind in (("--gt", Path(args.gt) / "seqinfo.ini", "a sequence folder with seqinfo.ini"),
+                                 ("--results", Path(args.results), "a results file")):
+        if not path.is_file():
+            raise UsageError(argument, f"{str(path)!r} not found; expected {kind}")
     from . import motchallenge
+
     s = scenario.ScoringConfig()
     metrics = motchallenge.evaluate_results(args.gt, args.results, similarity=args.similarity, threshold=args.threshold,
                                             zero_distance=s.zero_distance, gospa_c=s.gospa_c, gospa_p=s.gospa_p)
@@ -141,91 +409,137 @@ def cmd_eval(args) -> int:
 
 
 def cmd_config(args) -> int:
+    overrides = parse_overrides(args.config)
     if args.scenario:
-        print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, parse_overrides(args.config))), indent=2))
+        _loaded([args.scenario], overrides)
+        print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, overrides)), indent=2))
     else:
         print(scenario.reference_table())
     return 0
 
 
+# ------------------------------------------------------------------ the parser
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="mtt-sim", description="A Gymnasium environment for video multi-target tracking.")
-    sub = p.add_subparsers(dest="command", required=True)
+    p = _Parser(prog="mtt-sim", description="A Gymnasium environment for video multi-target tracking.")
+    p.add_argument("--version", action="version", version=f"mtt-sim {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="scenarios with their env ids and one-line descriptions").set_defaults(func=cmd_list)
+    sub.add_parser("trackers", help="trackers with their descriptions and parameters (default, allowed values)"
+                   ).set_defaults(func=cmd_trackers)
+    scenario_help = "scenario key (see `mtt-sim list`, any case), env id (mtt_sim/Crossing-v0) or .toml file"
+    config_help = "overrides, e.g. sensor.clutter_rate=5 groups.0.count=10"
+    force_help = "replace an existing output"
+
     run = sub.add_parser("run", help="run one episode with a tracker and print its metrics")
-    run.add_argument("scenario", help="scenario key (see `mtt-sim list`) or a .toml file")
-    run.add_argument("--tracker", default="sort", help="tracker spec, e.g. sort or 'sort:max_age=3' (default: sort)")
-    run.add_argument("--seed", type=int, default=0)
-    run.add_argument("--steps", type=int, default=0, help="at most this many steps (default: the scenario's env.max_steps)")
+    run.add_argument("scenario", type=_scenario, help=scenario_help)
+    run.add_argument("--tracker", type=_tracker_spec, default="sort",
+                     help="tracker spec, e.g. sort or 'sort:max_age=3,min_hits=1' (default: sort)")
+    run.add_argument("--seed", type=_integer(0), default=0, help="episode seed, >= 0 (default 0)")
+    run.add_argument("--steps", type=_integer(1), default=None, help="at most this many steps (default: the "
+                                                                        "scenario's env.max_steps)")
     run.add_argument("--video", help="write an annotated video (.mp4 or .avi)")
-    run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides, e.g. sensor.clutter_rate=5")
+    run.add_argument("--force", action="store_true", help=force_help)
+    run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.set_defaults(func=cmd_run)
-    for name, func, text in (("bench", cmd_bench, "a tracker x scenario x seed grid, as a table of mean and 95% interval"),
+
+    for name, func, text in (("bench", cmd_bench, "a tracker x scenario x seed grid, as a table of mean and 95%% "
+                                                   "interval"),
                              ("sweep", cmd_sweep, "a stress curve: one scenario, one parameter over several values")):
         g = sub.add_parser(name, help=text)
         if name == "bench":
-            g.add_argument("--scenarios", required=True, help="comma-separated scenario keys")
+            g.add_argument("--scenarios", type=_scenarios, required=True, help="comma-separated scenarios")
             g.add_argument("--by", choices=("scenario", "target"), default="scenario",
                            help="columns: scenarios, or ground-truth ids for the per-target metrics CentreError and "
                                 "Coverage (hand-initialised trackers; one scenario)")
         else:
-            g.add_argument("scenario")
+            g.add_argument("scenario", type=_scenario, help=scenario_help)
             g.add_argument("--param", required=True, metavar="KEY=V1,V2,...", help="e.g. sensor.clutter_rate=0,2,5,10,20")
-            g.add_argument("--plot", help="write the curve as a PNG (needs the [plot] extra: matplotlib)")
-        g.add_argument("--trackers", required=True, help="comma-separated tracker specs, e.g. sort,iou,'gnn:coast=true'")
-        g.add_argument("--seeds", type=int, default=5, help="seeds 0..N-1 (default 5)")
-        g.add_argument("--workers", type=int, default=1, help="parallel processes, or a local Ray instance's CPUs "
-                                                               "(default 1)")
-        g.add_argument("--backend", choices=experiment.BACKENDS, default="local",
+            g.add_argument("--plot", help="write the curve of the last --metric as a PNG, PDF or SVG (needs the [plot] "
+                                          "extra: matplotlib)")
+        g.add_argument("--trackers", type=_tracker_specs, required=True,
+                       help="tracker specs separated by commas, or by ';' when a spec has several parameters: "
+                            "sort,iou,gnn:coast=true or 'sort:min_hits=1,max_age=5;iou'")
+        g.add_argument("--seeds", type=parse_seeds, default=parse_seeds("5"),
+                       help="a count (5: seeds 0..4, the default), a list (3,7,11) or a range (100-199)")
+        g.add_argument("--workers", type=_integer(1), default=1,
+                       help="parallel processes, or a local Ray instance's CPUs (default 1)")
+        g.add_argument("--backend", choices=("local", "ray"), default="local",
                        help="local processes, or Ray tasks (the [ray] extra)")
         g.add_argument("--address", help="with --backend ray: a Ray cluster's address (default: start a local one)")
-        g.add_argument("--metric", default="MOTA", help="metric(s) of the tables, comma-separated (default MOTA)")
-        g.add_argument("--out", help="write every episode's record (.csv, or .json)")
+        g.add_argument("--metric", type=_metrics, default=["MOTA"],
+                       help="metric(s) of the tables, comma-separated, any case (default MOTA)")
+        g.add_argument("--out", help="write every episode's record as it finishes (.csv or .json)")
+        g.add_argument("--force", action="store_true", help=force_help)
         g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")
         g.set_defaults(func=func)
-    pf = sub.add_parser("perf", help="env steps/s and metrics cost at 20 and 200 targets, each against a same-run reference")
-    pf.add_argument("--repeats", type=int, default=5)
-    pf.add_argument("--steps", type=int, default=200)
+
+    pf = sub.add_parser("perf", help="speed and memory of the env, the metrics and the trackers, each against a "
+                                     "same-run reference")
+    pf.add_argument("--repeats", type=_integer(1), default=5, help="medians over this many repeats (default 5)")
+    pf.add_argument("--steps", type=_integer(1), default=200, help="env steps per repeat (default 200)")
     pf.set_defaults(func=cmd_perf)
+
     lr = sub.add_parser("learn-reid", help="learn lmb's XQDA re-identification metric from rendered crops")
-    lr.add_argument("--scenario", default="mot17_like")
-    lr.add_argument("--first-seed", type=int, default=1000, help="training seeds start here (default 1000, away "
-                                                                   "from the experiments' 0..9)")
-    lr.add_argument("--seeds", type=int, default=4)
-    lr.add_argument("--frames", type=int, default=300)
-    lr.add_argument("--every", type=int, default=15, help="take crops every this many frames")
-    lr.add_argument("--dims", type=int, default=16, help="XQDA subspace dimension")
-    lr.add_argument("--out", default=None, help="where to write (default: the file the package ships)")
+    lr.add_argument("--scenario", type=_scenario, default="mot17_like", help=scenario_help)
+    lr.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1000-1003"),
+                    help="training episodes: a count, list or range (default 1000-1003, away from the experiments' 0..9)")
+    lr.add_argument("--frames", type=_integer(1), default=300, help="frames per episode (default 300)")
+    lr.add_argument("--every", type=_integer(1), default=15, help="take crops every this many frames (default 15)")
+    lr.add_argument("--dims", type=_integer(1, 200), default=16, help="XQDA subspace dimension (default 16)")
+    lr.add_argument("--out", default="xqda.npz", help="where to write the metric (default: xqda.npz here)")
+    lr.add_argument("--install", action="store_true", help="replace the metric the package ships (every lmb uses it)")
+    lr.add_argument("--force", action="store_true", help=force_help)
     lr.set_defaults(func=cmd_learn_reid)
+
     ex = sub.add_parser("export", help="write an episode as a MOTChallenge sequence (frames, gt, detections)")
-    ex.add_argument("scenario")
+    ex.add_argument("scenario", type=_scenario, help=scenario_help)
     ex.add_argument("--out", required=True, help="the sequence folder to write")
-    ex.add_argument("--seed", type=int, default=0)
-    ex.add_argument("--steps", type=int, default=0, help="at most this many frames (default: env.max_steps)")
-    ex.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE")
+    ex.add_argument("--seed", type=_integer(0), default=0, help="episode seed, >= 0 (default 0)")
+    ex.add_argument("--steps", type=_integer(1), default=None, help="at most this many frames (default: env.max_steps)")
+    ex.add_argument("--force", action="store_true", help="write into a folder that is not empty (its old frames go)")
+    ex.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
     ex.set_defaults(func=cmd_export)
+
     ev = sub.add_parser("eval", help="score a MOTChallenge results file against an exported sequence")
     ev.add_argument("--gt", required=True, help="the sequence folder (with seqinfo.ini and gt/gt.txt)")
     ev.add_argument("--results", required=True, help="frame, id, x, y, w, h, ... per line")
     ev.add_argument("--similarity", choices=("iou", "centroid"), default="iou")
-    ev.add_argument("--threshold", type=float, default=0.5)
+    ev.add_argument("--threshold", type=_fraction, default=0.5, help="match threshold in (0, 1] (default 0.5)")
     ev.add_argument("--json", action="store_true")
     ev.set_defaults(func=cmd_eval)
+
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
-    cf.add_argument("scenario", nargs="?")
-    cf.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE")
+    cf.add_argument("scenario", nargs="?", type=_scenario, help=scenario_help)
+    cf.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
     cf.set_defaults(func=cmd_config)
     return p
 
 
+def _terminated(signum, frame):
+    raise KeyboardInterrupt  # SIGTERM stops a run as Ctrl-C does: workers stopped, finished records kept
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         return args.func(args)
-    except (ValueError, OSError, ImportError) as err:  # bad configs, specs, values, files, a missing extra
-        print(f"mtt-sim: error: {err}", file=sys.stderr)
+    except UsageError as err:
+        print(f"mtt-sim {args.command}: error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"mtt-sim {args.command}: interrupted", file=sys.stderr)
+        return INTERRUPTED
+    except BrokenPipeError:  # the reader went away (`mtt-sim trackers | head`): nothing left to say
+        sys.stdout = open(os.devnull, "w")
+        return 0
+    except (ValueError, OSError, ImportError) as err:  # what the arguments could not foresee: a file, a missing extra
+        print(f"mtt-sim {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

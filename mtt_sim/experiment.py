@@ -1,9 +1,10 @@
 """Experiments: one episode, tracker x scenario x seed grids in parallel processes, sweeps, tables.
 
 A record is a plain dict: tracker (the spec as given, e.g. "sort:max_age=3"), params (the tracker's
-resolved parameters), scenario, seed, config (the overrides), metrics (the episode summary),
-tracker_fps (frames per second of tracker time alone) and env_fps (of env time alone).
-The same arguments give the same records, whatever the number of workers.
+resolved parameters), scenario, seed, config (the overrides), error (None, or the one-line message of
+what failed), metrics (the episode summary; None if it failed), per_target, tracker_fps (frames per
+second of tracker time alone) and env_fps (of env time alone). The same arguments give the same records,
+whatever the number of workers. A failing episode is recorded as failed and the rest of the grid goes on.
 """
 
 from __future__ import annotations
@@ -12,25 +13,28 @@ import csv
 import itertools
 import json
 import math
-import multiprocessing
-import sys
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
-from scipy import stats
+from scipy.special import stdtrit
+from tqdm import tqdm
 
 import trackers
 
+from . import pool
 from .env import TrackingEnv
+from .metrics import METRICS, PER_TARGET
 from .overlay import VideoWriter, draw_debug
+
+BACKENDS = ("local", "ray")
 
 
 def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Mapping | None = None,
-                video: str | None = None, steps: int | None = None) -> dict:
-    """One episode of `tracker` on `scenario`; optionally an annotated video. Returns a record."""
+                video: str | None = None, steps: int | None = None, progress: bool = False) -> dict:
+    """One episode of `tracker` on `scenario`; optionally an annotated video and a progress bar (shown once the
+    episode has run for a second). Returns a record."""
     agent = trackers.make(tracker)
     obs_mode = "frame+detections" if agent.needs_frame or video else "detections"
     env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if video else None, obs_mode=obs_mode)
@@ -39,7 +43,9 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
     writer = VideoWriter(video, (env.scenario.render.width, env.scenario.render.height)) if video else None
     tracker_time = env_time = 0.0
     limit = steps or env.scenario.env.max_steps
-    for _ in range(limit):
+    steps_ = tqdm(range(limit), desc=f"{tracker} on {scenario}", unit="frame", delay=1.0, leave=False) if progress \
+        else range(limit)
+    for _ in steps_:
         start = time.perf_counter()
         tracks = agent.update(obs)
         mid = time.perf_counter()
@@ -56,23 +62,33 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
     metrics = env.metrics.summary()
     frames = metrics["num_frames"]
     return {"tracker": tracker, "params": agent.params, "scenario": str(scenario), "seed": seed,
-            "config": dict(config or {}), "metrics": metrics, "per_target": env.metrics.per_target(),
+            "config": dict(config or {}), "error": None, "metrics": metrics, "per_target": env.metrics.per_target(),
             "tracker_fps": frames / max(tracker_time, 1e-9), "env_fps": frames / max(env_time, 1e-9)}
 
 
-def _task(args):
-    return run_episode(*args)
+def failed_record(task: tuple, message: str) -> dict:
+    """The record of grid task (scenario, tracker, seed, config) whose episode failed with `message`."""
+    scenario, tracker, seed, config = task
+    return {"tracker": tracker, "params": {}, "scenario": str(scenario), "seed": seed, "config": dict(config),
+            "error": message, "metrics": None, "per_target": {}, "tracker_fps": math.nan, "env_fps": math.nan}
 
 
-BACKENDS = ("local", "ray")
+def _task(task: tuple) -> dict:
+    """One grid episode; an exception in it becomes a failed record with the error's first line."""
+    try:
+        return run_episode(*task)
+    except Exception as err:  # noqa: BLE001  (whatever one episode raises, the grid goes on)
+        return failed_record(task, f"{type(err).__name__}: {(str(err).splitlines() or [''])[0]}")
 
 
 def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequence[int] | int,
              config: Mapping | None = None, configs: Sequence[Mapping] | None = None, workers: int = 1,
-             progress: bool = False, backend: str = "local", address: str | None = None) -> list[dict]:
+             progress: bool = False, backend: str = "local", address: str | None = None,
+             on_record: Callable[[dict], None] | None = None) -> list[dict]:
     """Every tracker x scenario x seed (x config, for sweeps); records in grid order. backend="local" runs them in
     `workers` processes; "ray" as Ray tasks, on a local Ray instance of `workers` CPUs or on the cluster at
-    `address` (the [ray] extra)."""
+    `address` (the [ray] extra). `on_record` is called with each record as it finishes, so an interrupted grid
+    keeps what it finished (KeyboardInterrupt stops the workers and propagates)."""
     if backend not in BACKENDS:
         raise ValueError(f"backend={backend!r}: allowed values: {', '.join(map(repr, BACKENDS))}")
     seeds = range(seeds) if isinstance(seeds, int) else seeds
@@ -80,26 +96,33 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
         trackers.make(spec)  # fail fast on a bad spec, before any process starts
     tasks = [(sc, spec, seed, {**(config or {}), **c}) for c, sc, spec, seed in
              itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
-    bar = _Progress(len(tasks)) if progress else None
-    if backend == "ray":
-        return _run_on_ray(tasks, workers, address, bar)
-    if workers <= 1:
-        records = []
-        for t in tasks:
-            records.append(_task(t))
-            bar and bar.step(t)
-        return records
-    records = [None] * len(tasks)
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        futures = {pool.submit(_task, t): i for i, t in enumerate(tasks)}
-        for done in as_completed(futures):
-            records[futures[done]] = done.result()
-            bar and bar.step(tasks[futures[done]])
+    records: list = [None] * len(tasks)
+    with tqdm(total=len(tasks), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
+        for i, record in _finished(tasks, workers, backend, address):
+            records[i] = record
+            if on_record:
+                on_record(record)
+            bar.set_postfix_str(f"{record['tracker']} on {record['scenario']} seed {record['seed']}"
+                                + (" failed" if record["error"] else ""), refresh=False)
+            bar.update()
     return records
 
 
-def _run_on_ray(tasks: list, workers: int, address: str | None, bar) -> list[dict]:
-    """The episodes as Ray tasks, collected as they finish; a Ray instance started here is shut down after."""
+def _finished(tasks: list, workers: int, backend: str, address: str | None) -> Iterator[tuple[int, dict]]:
+    """(index, record) of every task as it finishes."""
+    if backend == "ray":
+        yield from _on_ray(tasks, workers, address)
+    elif workers <= 1:
+        for i, task in enumerate(tasks):
+            yield i, _task(task)
+    else:
+        for i, value in pool.run(_task, tasks, workers):
+            yield i, failed_record(tasks[i], value.message) if isinstance(value, pool.TaskFailed) else value
+
+
+def _on_ray(tasks: list, workers: int, address: str | None) -> Iterator[tuple[int, dict]]:
+    """The episodes as Ray tasks, as they finish; a Ray instance started here is shut down after, and tasks still
+    running when the caller stops are cancelled."""
     try:
         import ray
     except ImportError:
@@ -108,37 +131,22 @@ def _run_on_ray(tasks: list, workers: int, address: str | None, bar) -> list[dic
     if started:
         ray.init(address=address, num_cpus=None if address else max(1, workers), include_dashboard=False,
                  log_to_driver=False, configure_logging=False)
+    remote = ray.remote(_task)
+    index = {remote.remote(t): i for i, t in enumerate(tasks)}
+    pending = list(index)
     try:
-        remote = ray.remote(_task)
-        index = {remote.remote(t): i for i, t in enumerate(tasks)}
-        records, pending = [None] * len(tasks), list(index)
         while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            i = index[done[0]]
-            records[i] = ray.get(done[0])
-            bar and bar.step(tasks[i])
-        return records
+            (ref,), pending = ray.wait(pending, num_returns=1)
+            try:
+                record = ray.get(ref)
+            except ray.exceptions.RayError as err:  # the worker died (the episode's own errors are caught inside)
+                record = failed_record(tasks[index[ref]], f"{type(err).__name__}: {(str(err).splitlines() or [''])[0]}")
+            yield index[ref], record
     finally:
+        for ref in pending:
+            ray.cancel(ref, force=True)
         if started:
             ray.shutdown()
-
-
-class _Progress:
-    """A one-line progress bar on stderr."""
-
-    def __init__(self, total: int):
-        self.total, self.done, self.start = total, 0, time.perf_counter()
-
-    def step(self, task):
-        self.done += 1
-        filled = int(30 * self.done / self.total)
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed / self.done * (self.total - self.done)
-        sys.stderr.write(f"\r[{'#' * filled}{'.' * (30 - filled)}] {self.done}/{self.total} "
-                         f"{task[1]} on {task[0]} seed {task[2]}  {elapsed:.0f}s, {eta:.0f}s left   ")
-        if self.done == self.total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
 
 
 def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float]:
@@ -146,66 +154,109 @@ def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float]
     v = np.asarray(values, float)
     if len(v) < 2:
         return float(v.mean()) if len(v) else math.nan, 0.0
-    half = stats.t.ppf(0.5 + level / 2, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
+    half = stdtrit(len(v) - 1, 0.5 + level / 2) * v.std(ddof=1) / math.sqrt(len(v))  # Student's t quantile
     return float(v.mean()), float(half)
 
 
 def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario") -> list[dict]:
-    """One row per (tracker, `by`) cell: the metric's mean and 95 % interval over seeds, and the speeds. `by` is
-    "scenario", "config" (sweeps) or "target" (a per-target metric, CentreError or Coverage, per GT id)."""
+    """One row per (tracker, `by`) cell: the metric's mean and 95 % interval over the seeds that ran, how many failed,
+    and the speeds. `by` is "scenario", "config" (sweeps) or "target" (a per-target metric, CentreError or Coverage,
+    per GT id)."""
+    names = PER_TARGET if by == "target" else METRICS
+    if metric not in names:
+        raise ValueError(f"unknown {'per-target ' if by == 'target' else ''}metric {metric!r}; available: "
+                         f"{', '.join(names)}")
     cells: dict[tuple, list[tuple[float, dict]]] = {}
     for r in records:
-        if by == "target":
-            per = r["per_target"]
-            if per and metric not in next(iter(per.values())):
-                raise ValueError(f"unknown per-target metric {metric!r}; available: {', '.join(next(iter(per.values())))}")
-            for gid, values in sorted(per.items(), key=lambda kv: int(kv[0])):
-                cells.setdefault((r["tracker"], f"target {gid}"), []).append((values[metric], r))
-            continue
-        if metric not in r["metrics"]:
-            raise ValueError(f"unknown metric {metric!r}; available: {', '.join(r['metrics'])}")
         column = r["scenario"] if by == "scenario" else json.dumps(r["config"], sort_keys=True)
-        cells.setdefault((r["tracker"], column), []).append((r["metrics"][metric], r))
+        if r.get("error"):  # a failed cell; per target there is no column to put it in (the failures are listed apart)
+            if by != "target":
+                cells.setdefault((r["tracker"], column), []).append((math.nan, r))
+        elif by == "target":
+            for gid, values in sorted(r["per_target"].items(), key=lambda kv: int(kv[0])):
+                cells.setdefault((r["tracker"], f"target {gid}"), []).append((values[metric], r))
+        else:
+            cells.setdefault((r["tracker"], column), []).append((r["metrics"][metric], r))
     rows = []
     for (tracker, column), cell in cells.items():
-        values = np.array([v for v, _ in cell], float)
+        ran = [(v, r) for v, r in cell if not r.get("error")]
+        values = np.array([v for v, _ in ran], float)
         mean, ci = mean_ci(values[np.isfinite(values)])
-        rs = [r for _, r in cell]
-        rows.append({"tracker": tracker, "column": column, "metric": metric, "mean": mean, "ci95": ci, "n": len(rs),
-                     "tracker_fps": float(np.median([r["tracker_fps"] for r in rs])),
-                     "env_fps": float(np.median([r["env_fps"] for r in rs]))})
+        rows.append({"tracker": tracker, "column": column, "metric": metric, "mean": mean, "ci95": ci, "n": len(ran),
+                     "failed": len(cell) - len(ran),
+                     "tracker_fps": float(np.median([r["tracker_fps"] for _, r in ran])) if ran else math.nan,
+                     "env_fps": float(np.median([r["env_fps"] for _, r in ran])) if ran else math.nan})
     return rows
 
 
 def markdown(rows: Sequence[dict], title: str = "") -> str:
-    """Trackers x columns table of mean ± 95 % interval, with median frames/s of tracker time and of env time."""
+    """Trackers x columns table of mean ± 95 % interval, with median frames/s of tracker time and of env time. A cell
+    whose episodes all failed reads "failed"; one where some did says how many."""
     trackers_, columns = list(dict.fromkeys(r["tracker"] for r in rows)), list(dict.fromkeys(r["column"] for r in rows))
     cell = {(r["tracker"], r["column"]): r for r in rows}
-    metric, n = rows[0]["metric"], rows[0]["n"]
+    metric, n = rows[0]["metric"], max(r["n"] + r["failed"] for r in rows)
     head = f"{metric} (mean ± 95% interval over {n} seeds)" + (f", {title}" if title else "")
     lines = [head, "", "| tracker | " + " | ".join(columns) + " | tracker frames/s | env frames/s |",
              "|---|" + "---:|" * (len(columns) + 2)]
     for t in trackers_:
-        values = [f"{cell[t, c]['mean']:.3f} ± {cell[t, c]['ci95']:.3f}" if (t, c) in cell else "" for c in columns]
-        fps, env_fps = (np.median([cell[t, c][k] for c in columns if (t, c) in cell]) for k in ("tracker_fps", "env_fps"))
-        lines.append(f"| {t} | " + " | ".join(values) + f" | {fps:.0f} | {env_fps:.0f} |")
+        values = [_cell_text(cell.get((t, c))) for c in columns]
+        speeds = ([cell[t, c][k] for c in columns if (t, c) in cell and cell[t, c]["n"]] for k in ("tracker_fps", "env_fps"))
+        lines.append(f"| {t} | " + " | ".join(values) + " | " + " | ".join(
+            f"{np.median(v):.0f}" if v else "-" for v in speeds) + " |")
     return "\n".join(lines)
+
+
+def _cell_text(row: dict | None) -> str:
+    if row is None:
+        return ""
+    if not row["n"]:
+        return "failed"
+    failed = f" ({row['failed']} of {row['n'] + row['failed']} failed)" if row["failed"] else ""
+    return f"{row['mean']:.3f} ± {row['ci95']:.3f}{failed}"
 
 
 def write_records(records: Sequence[dict], path: str | Path) -> None:
     """Records as JSON (.json) or CSV (anything else: one row per episode, metrics as columns)."""
-    path = Path(path)
-    if path.suffix == ".json":
-        path.write_text(json.dumps(list(records), indent=1))
-        return
-    metric_keys = list(records[0]["metrics"]) if records else []
-    with path.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["tracker", "params", "scenario", "seed", "config", "tracker_fps", "env_fps", *metric_keys])
+    with RecordFile(path) as out:
         for r in records:
-            w.writerow([r["tracker"], json.dumps(r["params"], sort_keys=True), r["scenario"], r["seed"],
-                        json.dumps(r["config"], sort_keys=True), f"{r['tracker_fps']:.1f}", f"{r['env_fps']:.1f}",
-                        *(r["metrics"][k] for k in metric_keys)])
+            out.append(r)
+
+
+class RecordFile:
+    """Records written to a .json or CSV file as they come, the file complete and readable after every one."""
+
+    HEADER = ["tracker", "params", "scenario", "seed", "config", "error", "tracker_fps", "env_fps", *METRICS]
+
+    def __init__(self, path: str | Path):
+        self.path, self.count = Path(path), 0
+        self.json = self.path.suffix == ".json"
+        self.file = self.path.open("wb" if self.json else "w", newline="" if not self.json else None)
+        if self.json:
+            self.file.write(b"[\n]\n")
+        else:
+            self.csv = csv.writer(self.file)
+            self.csv.writerow(self.HEADER)
+        self.file.flush()
+
+    def append(self, r: dict) -> None:
+        if self.json:  # overwrite the list's end, then end it again
+            self.file.seek(-3 if self.count else -2, 2)
+            self.file.write((b",\n" if self.count else b"") + json.dumps(r).encode() + b"\n]\n")
+        else:
+            self.csv.writerow([r["tracker"], json.dumps(r["params"], sort_keys=True), r["scenario"], r["seed"],
+                               json.dumps(r["config"], sort_keys=True), r["error"] or "", f"{r['tracker_fps']:.1f}",
+                               f"{r['env_fps']:.1f}", *((r["metrics"] or {}).get(k, "") for k in METRICS)])
+        self.count += 1
+        self.file.flush()
+
+    def close(self) -> None:
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
 def sweep_plot(rows: Sequence[dict], param: str, values: Sequence, path: str | Path) -> None:

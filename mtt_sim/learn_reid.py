@@ -10,15 +10,17 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from trackers import reid
 
 from .env import NO_TRACKS, TrackingEnv
 
 def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility: float = 0.9,
-                   min_height: float = 24.0) -> tuple[np.ndarray, np.ndarray]:
+                   min_height: float = 24.0, progress: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """LOMO features and class numbers (one per target and episode) of the training crops."""
     features, classes = [], []
+    bar = tqdm(total=len(seeds) * frames, unit="frame", desc="rendering crops", disable=not progress)
     for seed in seeds:
         env = TrackingEnv(scenario, config={"env.max_steps": frames})
         obs, _ = env.reset(seed=seed)
@@ -30,17 +32,22 @@ def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility
                     features.append(reid.lomo(crop))
                     classes.append(seed * 1_000_000 + int(target))
             obs, _, term, trunc, _ = env.step(NO_TRACKS)
+            bar.update()
             if term or trunc:
                 break
+    bar.close()
     return np.array(features), np.array(classes)
 
 
-def learn(scenario: str = "mot17_like", seeds=range(1000, 1004), frames: int = 300, every: int = 15,
-          dims: int = 16, out: str | Path | None = None) -> dict:
-    """Learn the metric and save it (by default where the package ships it); returns a summary."""
-    features, classes = training_crops(scenario, seeds, frames, every)
+def learn(out: str | Path, scenario: str = "mot17_like", seeds=range(1000, 1004), frames: int = 300, every: int = 15,
+          dims: int = 16, progress: bool = False) -> dict:
+    """Learn the metric and save it at `out` (reid.METRIC_FILE is the file the package ships); returns a summary."""
+    features, classes = training_crops(scenario, seeds, frames, every, progress=progress)
+    if len(np.unique(classes)) < 2:
+        raise ValueError(f"learn-reid: {len(features)} crops of {len(np.unique(classes))} targets are too few to learn "
+                         "from; use more seeds or frames")
     arrays = reid.learn_xqda(features, classes, dims=dims)
-    out = Path(out or reid.METRIC_FILE)
+    out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(out, **{k: v.astype(np.float16) if k == "projection" else v for k, v in arrays.items()})
     return {"crops": len(features), "classes": len(np.unique(classes)), "feature_size": features.shape[1],

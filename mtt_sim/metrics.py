@@ -494,3 +494,6 @@ def evaluate(gt: Sequence[tuple], tracks: Sequence[tuple], similarity: str = "io
         metrics.update(gi, gb, ti, tb)
     return metrics.summary()
 
+
+METRICS = tuple(EpisodeMetrics().summary())  # every metric of an episode summary, in summary order
+PER_TARGET = ("CentreError", "Coverage")  # the metrics of EpisodeMetrics.per_target()

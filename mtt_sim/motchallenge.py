@@ -18,22 +18,27 @@ from typing import Mapping
 
 import cv2
 import numpy as np
+from tqdm import tqdm
 
 from .env import NO_TRACKS, TrackingEnv
 from .metrics import evaluate
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
-           config: Mapping | None = None) -> dict:
-    """Run `scenario` without a tracker and write its frames, ground truth and detections as a sequence."""
+           config: Mapping | None = None, progress: bool = False) -> dict:
+    """Run `scenario` without a tracker and write its frames, ground truth and detections as a sequence. Frames an
+    earlier, longer export left in `out` are removed."""
     out = Path(out)
     (out / "img1").mkdir(parents=True, exist_ok=True)
     (out / "gt").mkdir(exist_ok=True)
     (out / "det").mkdir(exist_ok=True)
+    for old in (out / "img1").glob("[0-9]*.jpg"):
+        old.unlink()
     env = TrackingEnv(scenario, config=config, obs_mode="frame+detections")
     obs, _ = env.reset(seed=seed)
     sc = env.scenario
     limit = steps or sc.env.max_steps
     gt_rows, det_rows = [], []
+    bar = tqdm(total=limit, unit="frame", desc=f"exporting {out}", disable=not progress)
     frame = 0
     while True:
         frame += 1
@@ -45,9 +50,11 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
                     for i, b, c, v in zip(t.ids, t.boxes.tolist(), considered, t.visibility)]
         dets = obs["detections"][: int(obs["num_detections"])]
         det_rows += [(frame, -1, *d[:4], d[4], -1, -1, -1) for d in dets.tolist()]
+        bar.update()
         obs, _, terminated, truncated, _ = env.step(NO_TRACKS)
         if terminated or truncated or frame >= limit:
             break
+    bar.close()
     _write_rows(out / "gt" / "gt.txt", gt_rows)
     _write_rows(out / "det" / "det.txt", det_rows)
     info = configparser.ConfigParser()

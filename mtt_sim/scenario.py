@@ -9,6 +9,8 @@ and what is allowed. The same metadata generates the README's configuration refe
 from __future__ import annotations
 
 import dataclasses
+import difflib
+import functools
 import math
 import tomllib
 import typing
@@ -233,8 +235,10 @@ def _type_name(tp) -> str:
 def _convert(value, tp, key: str, meta: Mapping, where: str):
     """Check `value` against annotation `tp` and the field's range/choices; return the typed value."""
 
+    given = value
+
     def fail(allowed: str):
-        raise ConfigError(f"{where}: {key} = {value!r}: {allowed}")
+        raise ConfigError(f"{where}: {key} = {given!r}: {allowed}")
 
     if isinstance(value, (np.generic, np.ndarray)):  # numpy numbers and arrays are numbers and lists
         value = value.tolist()
@@ -310,9 +314,11 @@ def _hints(cls) -> dict[str, Any]:
 def _build(cls, raw: Mapping, where: str, prefix: str = ""):
     """Construct dataclass `cls` from mapping `raw`, validating every key."""
     fields = {f.name: f for f in dataclasses.fields(cls)}
-    unknown = sorted(set(raw) - set(fields))
+    unknown = sorted(set(raw) - set(fields), key=str)
     if unknown:
-        raise ConfigError(f"{where}: unknown key {prefix}{unknown[0]}; allowed keys: {', '.join(fields)}")
+        near = difflib.get_close_matches(str(unknown[0]), fields, n=1)
+        raise ConfigError(f"{where}: unknown key {prefix}{unknown[0]}" + (f" (did you mean {prefix}{near[0]}?)" if near
+                          else "") + f"; allowed keys: {', '.join(fields)}")
     hints = _hints(cls)
     values = {name: _convert(raw[name], hints[name], prefix + name, fields[name].metadata, where)
               for name in fields if name in raw}
@@ -419,17 +425,37 @@ def available() -> dict[str, str]:
     return out
 
 
+@functools.cache
+def shipped_names() -> dict[str, str]:
+    """Shipped scenario keys mapped to their CamelCase names (the env id of key k is mtt_sim/<name>-v0)."""
+    return {p.name[:-5]: tomllib.loads(p.read_text()).get("name", "Custom")
+            for p in sorted(scenario_dir().iterdir(), key=lambda p: p.name) if p.name.endswith(".toml")}
+
+
+def resolve(name: str | Path) -> str | Path:
+    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml path is
+    returned as a Path. An unknown name gets the list of keys and, for a near miss, a suggestion."""
+    if isinstance(name, Path) or str(name).endswith(".toml"):
+        if not Path(name).is_file():
+            raise ConfigError(f"scenario file {str(name)!r}: not found")
+        return Path(name)
+    keys = shipped_names()
+    spellings = {k.lower(): k for k in keys} | {f"mtt_sim/{n}-v0".lower(): k for k, n in keys.items()}
+    typed = str(name).strip().lower()
+    if typed in spellings:
+        return spellings[typed]
+    near = difflib.get_close_matches(typed, spellings, n=1, cutoff=0.7)
+    raise ConfigError(f"unknown scenario {str(name)!r}" + (f" (did you mean {spellings[near[0]]!r}?)" if near else "")
+                      + f"; available: {', '.join(keys)} (in any case, or their env ids, or a .toml file)")
+
+
 def load_raw(key_or_path: str | Path) -> tuple[dict, str]:
-    """Read a scenario's TOML mapping by shipped key or file path; returns (mapping, where)."""
-    path = Path(key_or_path)
-    if path.suffix == ".toml" and path.exists():
-        text, where = path.read_text(), str(path)
+    """Read a scenario's TOML mapping by shipped key (see `resolve`) or file path; returns (mapping, where)."""
+    found = resolve(key_or_path)
+    if isinstance(found, Path):
+        text, where = found.read_text(), str(found)
     else:
-        entry = scenario_dir() / f"{key_or_path}.toml"
-        if not entry.is_file():
-            keys = sorted(p.name[:-5] for p in scenario_dir().iterdir() if p.name.endswith(".toml"))
-            raise ConfigError(f"unknown scenario {str(key_or_path)!r}; available: {', '.join(keys)}")
-        text, where = entry.read_text(), f"scenarios/{key_or_path}.toml"
+        text, where = (scenario_dir() / f"{found}.toml").read_text(), f"scenarios/{found}.toml"
     try:
         return tomllib.loads(text), where
     except tomllib.TOMLDecodeError as err:
@@ -553,5 +579,5 @@ def reference_table() -> str:
 
 __all__ = ["Scenario", "GroupConfig", "DoorConfig", "OccluderConfig", "WorldConfig", "RenderConfig", "SensorConfig",
            "EnvConfig", "ScoringConfig", "ConfigError", "PRESETS", "available", "load", "load_raw", "from_mapping", "to_mapping",
-           "merge", "expand_dotted", "reference_table"]
+           "merge", "expand_dotted", "reference_table", "resolve", "shipped_names"]
 

@@ -51,3 +51,15 @@ def run_tracker(spec, env_id, config=None, seed=0, obs_mode="detections"):
         obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
         if term or trunc:
             return info["metrics"], tracker
+
+
+def fail_on_two(x):
+    """A pool task: raises for 2, kills its own process for 3, else doubles."""
+    import os
+    import signal
+
+    if x == 2:
+        raise ValueError("two is not allowed")
+    if x == 3:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return 2 * x

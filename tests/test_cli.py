@@ -1,14 +1,18 @@
 """The mtt-sim command."""
 
+import argparse
 import csv
+import importlib.metadata
 import json
+import re
 import subprocess
 import sys
 
 import cv2
 import pytest
 
-from mtt_sim import cli, perf
+import trackers
+from mtt_sim import cli, experiment, perf
 
 
 def mtt_sim(*args):
@@ -51,20 +55,134 @@ def test_bench_table_and_records(tmp_path, capsys):
     assert len(rows) == 8 and {r["tracker"] for r in rows} == {"sort", "iou"} and "MOTA" in rows[0]
 
 
-def test_sweep_without_matplotlib_says_how_to_install(tmp_path, capsys, monkeypatch):
+def test_sweep_without_matplotlib_says_how_to_install_before_any_work(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     code = cli.main(["sweep", "clutter_storm", "--param", "sensor.clutter_rate=0,10", "--trackers", "sort",
                      "--seeds", "1", "--config", "env.max_steps=10", "--plot", str(tmp_path / "p.png")])
     captured = capsys.readouterr()
-    assert "clutter_rate=0" in captured.out and "clutter_rate=10" in captured.out
-    assert code == 2 and "pip install 'mtt-sim[plot]'" in captured.err
+    assert code == 2 and "argument --plot: needs matplotlib: pip install 'mtt-sim[plot]'" in captured.err
+    assert "clutter_rate=0" not in captured.out  # nothing ran
 
 
-def test_errors_are_one_line_with_exit_code_two():
-    out = mtt_sim("run", "nowhere")
-    assert out.returncode == 2 and out.stderr.startswith("mtt-sim: error: unknown scenario 'nowhere'")
-    out = mtt_sim("run", "crossing", "--config", "sensor.pd=2")
-    assert out.returncode == 2 and "sensor.pd = 2" in out.stderr and "Traceback" not in out.stderr
+def test_every_help_works():
+    for argv in (["--help"], ["-h"]):
+        out = mtt_sim(*argv)
+        assert out.returncode == 0 and "95% interval" in out.stdout
+    commands = next(a for a in cli.build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert {"run", "bench", "sweep", "perf", "config", "learn-reid", "export", "eval", "list", "trackers"} <= set(commands)
+    for name in commands:
+        with pytest.raises(SystemExit) as done:
+            cli.main([name, "--help"])
+        assert done.value.code == 0, name
+
+
+def test_version_is_the_installed_one():
+    out = mtt_sim("--version")
+    assert out.returncode == 0 and out.stdout.strip() == f"mtt-sim {importlib.metadata.version('mtt-sim')}"
+
+
+BAD_ARGUMENTS = [
+    (["run", "crossing", "--steps", "-5"], r"argument --steps: must be an integer >= 1, got '-5'"),
+    (["run", "crossing", "--seed", "-1"], r"argument --seed: must be an integer >= 0, got '-1'"),
+    (["run", "socer"], r"unknown scenario 'socer' \(did you mean 'soccer'\?\)"),
+    (["run", "crossing", "--tracker", "sortt"], r"unknown tracker 'sortt' \(did you mean 'sort'\?\)"),
+    (["run", "crossing", "--tracker", "sort:max_age=-5"], r"parameter max_age='-5': allowed: an integer in \[0, inf\)"),
+    (["run", "crossing", "--config", "sensor.pd=2"], r"argument --config: .*sensor\.pd = 2: out of range"),
+    (["run", "crossing", "--video", "out.gif"], r"argument --video: 'out.gif': the file name must end in \.mp4 or \.avi"),
+    (["run", "crossing", "--video", "/nowhere/out.mp4"], r"argument --video: .* folder '/nowhere' does not exist"),
+    (["bench", "--scenarios", "crossing,nope", "--trackers", "sort"], r"argument --scenarios: unknown scenario 'nope'"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--metric", "MOTA,hotaa"],
+     r"argument --metric: unknown metric 'hotaa' \(did you mean 'HOTA'\?\)"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--seeds", "0"], r"argument --seeds: '0': expected a count"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--seeds", "9-3"], r"argument --seeds: '9-3'"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--seeds", "1,1"], r"a seed is given twice"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--workers", "0"], r"argument --workers: must be"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--out", "r.txt"], r"must end in \.csv or \.json"),
+    (["bench", "--scenarios", "crossing", "--trackers", "sort", "--by", "target"],
+     r"argument --metric: with --by target: CentreError or Coverage"),
+    (["sweep", "crossing", "--param", "sensor.pd=0.5,2", "--trackers", "sort"], r"argument --param: .*sensor\.pd = 2"),
+    (["sweep", "crossing", "--param", "sensor.pd", "--trackers", "sort"], r"argument --param: 'sensor.pd': expected key="),
+    (["learn-reid", "--every", "0"], r"argument --every: must be an integer >= 1, got '0'"),
+    (["learn-reid", "--out", "metric.txt"], r"argument --out: 'metric.txt': the file name must end in \.npz"),
+    (["perf", "--repeats", "0"], r"argument --repeats: must be an integer >= 1"),
+    (["export", "crossing", "--out", "seq", "--steps", "0"], r"argument --steps: must be an integer >= 1"),
+    (["eval", "--gt", "nowhere", "--results", "r.txt"], r"argument --gt: 'nowhere/seqinfo.ini' not found"),
+    (["eval", "--gt", "nowhere", "--results", "r.txt", "--threshold", "1.5"], r"--threshold: must be a number in \(0, 1\]"),
+    (["config", "crossing", "--config", "sensor"], r"argument --config: 'sensor': expected key=value"),
+]
+
+
+@pytest.mark.parametrize("argv, pattern", BAD_ARGUMENTS)
+def test_a_bad_argument_gets_one_line_and_exit_two_before_any_work(argv, pattern, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = cli.main(argv)
+    except SystemExit as done:  # argparse's own checks
+        code = done.code
+    err = capsys.readouterr().err
+    assert code == 2 and re.search(pattern, err), err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not list(tmp_path.iterdir())  # nothing was written
+
+
+def test_names_are_case_insensitive_and_env_ids_are_scenarios(capsys):
+    assert cli.main(["run", "mtt_sim/ClutterStorm-v0", "--tracker", "SORT", "--steps", "3", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert cli.main(["run", "Clutter_Storm", "--tracker", "sort", "--steps", "3", "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert first["scenario"] == again["scenario"] == "clutter_storm" and first["tracker"] == "sort"
+    assert first["MOTA"] == again["MOTA"]
+    assert cli.main(["bench", "--scenarios", "CROSSING", "--trackers", "Sort", "--seeds", "1", "--metric", "mota,Idf1",
+                     "--config", "env.max_steps=3"]) == 0
+    out = capsys.readouterr().out
+    assert "MOTA (mean" in out and "IDF1 (mean" in out and "| sort | " in out and "| crossing |" in out
+
+
+def test_tracker_specs_with_several_parameters_and_seed_forms(tmp_path, capsys):
+    out = tmp_path / "r.csv"
+    assert cli.main(["bench", "--scenarios", "clutter_storm", "--trackers", "sort:min_hits=1,max_age=5,iou,gnn:coast=true",
+                     "--seeds", "3,7", "--config", "env.max_steps=4", "--out", str(out)]) == 0
+    rows = list(csv.DictReader(out.open()))
+    assert [r["tracker"] for r in rows] == ["sort:min_hits=1,max_age=5"] * 2 + ["iou"] * 2 + ["gnn:coast=true"] * 2
+    assert json.loads(rows[0]["params"])["max_age"] == 5 and [r["seed"] for r in rows[:2]] == ["3", "7"]
+    assert cli.parse_seeds("100-102,7") == [100, 101, 102, 7] and cli.parse_seeds("3") == [0, 1, 2]
+    assert trackers.split_specs("sort:min_hits=1,max_age=5;iou") == ["sort:min_hits=1,max_age=5", "iou"]
+
+
+def test_trackers_lists_every_tracker_with_its_parameters(capsys):
+    assert cli.main(["trackers"]) == 0
+    out = capsys.readouterr().out
+    for name in trackers.available():
+        assert f"\n{name}: " in "\n" + out
+    assert "max_age=1" in out and "an integer in [0, inf)" in out and "'keep', 'zero'" in out
+
+
+def test_an_existing_output_is_refused_unless_forced(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    out.write_text("precious")
+    args = ["bench", "--scenarios", "crossing", "--trackers", "sort", "--seeds", "1", "--config", "env.max_steps=3",
+            "--out", str(out)]
+    assert cli.main(args) == 2 and "exists; add --force to replace it" in capsys.readouterr().err
+    assert out.read_text() == "precious"
+    assert cli.main(args + ["--force"]) == 0 and "(replaced)" in capsys.readouterr().out
+    assert len(json.loads(out.read_text())) == 1
+
+
+def test_export_into_an_older_longer_export_leaves_no_stale_frames(tmp_path, capsys):
+    seq = tmp_path / "seq"
+    assert cli.main(["export", "crossing", "--out", str(seq), "--steps", "6"]) == 0
+    assert cli.main(["export", "crossing", "--out", str(seq), "--steps", "3"]) == 2
+    assert "not empty; add --force" in capsys.readouterr().err
+    assert cli.main(["export", "crossing", "--out", str(seq), "--steps", "3", "--force"]) == 0
+    assert sorted(p.name for p in (seq / "img1").iterdir()) == ["000001.jpg", "000002.jpg", "000003.jpg"]
+    assert "exporting" in capsys.readouterr().err  # the progress bar
+
+
+def test_a_long_run_shows_progress(monkeypatch, capsys):
+    bars = []
+    monkeypatch.setattr(experiment, "tqdm", lambda *a, **k: bars.append(k) or a[0])
+    assert cli.main(["run", "crossing", "--steps", "3"]) == 0
+    assert bars and bars[0]["delay"] == 1.0  # shown once a run has taken a second
 
 
 @pytest.mark.parametrize("text, value", [("sensor.pd=0.5", 0.5), ("render.camera=shake", "shake"),

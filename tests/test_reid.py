@@ -3,6 +3,7 @@ known answer, the FIFO pool, and `mtt-sim learn-reid` reproducing the shipped me
 
 import numpy as np
 
+import trackers
 from mtt_sim import cli
 from trackers import reid
 
@@ -54,13 +55,16 @@ def test_pool_is_fifo_skips_labels_in_use_and_respects_the_threshold():
     assert found.tolist() == [2, 0, 0]     # 3 is in use; nothing lies within reach of the third
 
 
-def test_learn_reid_writes_a_metric_the_tracker_can_load(tmp_path, capsys):
-    out = tmp_path / "xqda.npz"
-    assert cli.main(["learn-reid", "--seeds", "1", "--frames", "30", "--every", "10", "--dims", "4",
-                     "--out", str(out)]) == 0
-    assert "crops" in capsys.readouterr().out
-    with np.load(out) as f:
-        metric = reid.Metric(dict(f))
+def test_learn_reid_writes_a_metric_the_tracker_can_load(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    shipped_before = reid.METRIC_FILE.read_bytes()
+    assert cli.main(["learn-reid", "--seeds", "1", "--frames", "30", "--every", "10", "--dims", "4"]) == 0
+    captured = capsys.readouterr()
+    assert "crops" in captured.out and "lmb:reid_metric=xqda.npz" in captured.out and "rendering crops" in captured.err
+    assert reid.METRIC_FILE.read_bytes() == shipped_before  # the installed file is replaced only with --install
+    metric = reid.Metric.from_file(tmp_path / "xqda.npz")
     assert metric.projection.shape == (len(metric.mean), 4) and metric.kernel.shape == (4, 4)
-    shipped = reid.Metric.shipped()
-    assert shipped.projection.shape[0] == len(metric.mean)    # the shipped file matches today's feature
+    assert trackers.make("lmb:reid_metric=xqda.npz").metric.kernel.shape == (4, 4)
+    assert reid.Metric.from_file().projection.shape[0] == len(metric.mean)  # the shipped file matches today's feature
+    assert cli.main(["learn-reid", "--seeds", "1", "--frames", "30"]) == 2
+    assert "'xqda.npz' exists; add --force" in capsys.readouterr().err

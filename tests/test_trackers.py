@@ -89,7 +89,8 @@ def test_registry_and_parameters():
     assert all(trackers.available()[n] for n in BASELINES)
     t = trackers.make("sort:max_age=4,min_hits=1", iou_threshold=0.2)
     assert t.params == {"max_age": 4, "min_hits": 1, "iou_threshold": 0.2, "min_confidence": 0.0}
-    with pytest.raises(ValueError, match="unknown tracker 'deepsort'; available: " + ", ".join(sorted(trackers.available()))):
+    with pytest.raises(ValueError, match=r"unknown tracker 'deepsort' \(did you mean 'sort'\?\); available: "
+                                         + ", ".join(sorted(trackers.available()))):
         trackers.make("deepsort")
     with pytest.raises(ValueError, match=r"tracker 'sort': unknown parameter 'max_ages' \(did you mean 'max_age'\?\); "
                                          r"allowed: max_age \(default 1\)"):
@@ -122,7 +123,7 @@ def test_every_numeric_parameter_has_a_range():
     """Only thresholds on detector confidences (raw scores may lie outside [0, 1]) take any finite number."""
     for name, cls in trackers.base.REGISTRY.items():
         for key, param in cls.parameters.items():
-            if param.allowed == "(-inf, inf)" and not isinstance(param.default, bool):
+            if param.allowed is None and isinstance(param.default, (int, float)) and not isinstance(param.default, bool):
                 assert "confidence" in key or key in ("sigma_l", "sigma_h", "track_thresh", "low_thresh",
                                                       "new_track_thresh"), (name, key)
             assert param.check(name, key, param.default) == param.default, (name, key)

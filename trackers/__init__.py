@@ -7,7 +7,7 @@
 """
 
 from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, lmb, particle, sort  # noqa: F401  (each registers its tracker)
-from .base import Tracker, Tracks, available, make, parse_spec, register
+from .base import Param, Tracker, Tracks, available, make, parse_spec, register, split_specs
 from .external import External
 
-__all__ = ["External", "Tracker", "Tracks", "available", "make", "parse_spec", "register"]
+__all__ = ["External", "Param", "Tracker", "Tracks", "available", "make", "parse_spec", "register", "split_specs"]

@@ -6,7 +6,7 @@ import heapq
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 
 def iou_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -21,7 +21,7 @@ def iou_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def chi2_gate(dim: int, probability: float = 0.99) -> float:
     """The squared-Mahalanobis gate that a true measurement passes with `probability`."""
-    return float(chi2.ppf(probability, dim))
+    return float(chdtri(dim, 1.0 - probability))  # chi2.ppf(probability, dim), without importing scipy.stats
 
 
 def assign(cost: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

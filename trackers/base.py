@@ -103,11 +103,11 @@ _INTERVAL = re.compile(r"^([\[(])(-inf|[-+0-9.e]+), (inf|[-+0-9.e]+)([\])])$")
 @dataclass(frozen=True)
 class Param:
     """A tracker parameter: its default and the values it may take. `allowed` is an interval for a number ("[0, 1]",
-    "(0, inf)": brackets include the end, parentheses exclude it; by default any finite number) or a tuple of
-    choices for a string; a bool takes true or false."""
+    "(0, inf)": brackets include the end, parentheses exclude it) or a tuple of choices for a string; None allows any
+    finite number, any string. A bool takes true or false."""
 
     default: Any
-    allowed: str | tuple[str, ...] = "(-inf, inf)"
+    allowed: str | tuple[str, ...] | None = None
 
     def __post_init__(self):
         if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
@@ -119,7 +119,8 @@ class Param:
             return "true or false"
         if isinstance(self.allowed, tuple):
             return ", ".join(map(repr, self.allowed))
-        return f"{'an integer' if kind is int else 'a number'} in {self.allowed}"
+        what = {int: "an integer", float: "a number", str: "a string"}[kind]
+        return what + (f" in {self.allowed}" if self.allowed else "")
 
     def check(self, tracker: str, key: str, value):
         """`value` converted to the default's type and inside the allowed values, or a ValueError saying which are."""
@@ -130,7 +131,7 @@ class Param:
         return out
 
     def _allows(self, value) -> bool:
-        if isinstance(value, bool):
+        if self.allowed is None or isinstance(value, bool):
             return True
         if isinstance(self.allowed, tuple):
             return value in self.allowed
@@ -210,19 +211,39 @@ def available() -> dict[str, str]:
 
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
     """'sort:max_age=3,min_hits=1' -> ('sort', {'max_age': '3', 'min_hits': '1'})."""
-    name, _, rest = spec.partition(":")
-    params = {}
-    for item in filter(None, rest.split(",")):
+    name, _, rest = str(spec).partition(":")
+    params: dict[str, str] = {}
+    for item in filter(None, (i.strip() for i in rest.split(","))):
         key, sep, value = item.partition("=")
-        if not sep:
-            raise ValueError(f"tracker spec {spec!r}: expected name:key=value,key=value")
+        if not sep or not key.strip():
+            raise ValueError(f"tracker spec {spec!r}: expected name:key=value,key=value, e.g. 'sort:max_age=3,min_hits=1'")
+        if key.strip() in params:
+            raise ValueError(f"tracker spec {spec!r}: parameter {key.strip()!r} is given twice")
         params[key.strip()] = value.strip()
     return name.strip(), params
 
 
+def split_specs(text: str) -> list[str]:
+    """The tracker specs in one string: "sort,iou", "sort:min_hits=1,max_age=5,iou" (an item with "=" but no ":"
+    continues the spec before it) or, separated by ";", "sort:min_hits=1,max_age=5;iou"."""
+    specs: list[str] = []
+    for part in text.split(";"):
+        first = len(specs)
+        for item in filter(None, (i.strip() for i in part.split(","))):
+            if "=" in item and ":" not in item and len(specs) > first:
+                specs[-1] += "," + item
+            else:
+                specs.append(item)
+    return specs
+
+
 def make(spec: str, **params) -> Tracker:
-    """A tracker by name or spec ('sort', 'sort:max_age=3'); keyword parameters override the spec's."""
+    """A tracker by name (in any letter case) or spec ('sort', 'sort:max_age=3'); keyword parameters override the
+    spec's."""
     name, spec_params = parse_spec(spec)
-    if name not in REGISTRY:
-        raise ValueError(f"unknown tracker {name!r}; available: {', '.join(sorted(REGISTRY))}")
-    return REGISTRY[name](**{**spec_params, **params})
+    cls = REGISTRY.get(name.lower())
+    if cls is None:
+        near = difflib.get_close_matches(name.lower(), REGISTRY, n=1)
+        raise ValueError(f"unknown tracker {name!r}" + (f" (did you mean {near[0]!r}?)" if near else "")
+                         + f"; available: {', '.join(sorted(REGISTRY))}")
+    return cls(**{**spec_params, **params})

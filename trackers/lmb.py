@@ -114,7 +114,8 @@ class LabelledMultiBernoulli(Tracker):
     most likely measurement has confidence >= `reid_confidence` puts that detection's LOMO feature (XQDA-embedded)
     with its label in a FIFO pool of `pool_per_target` x (targets of the first frame) entries; a track reported
     for the first time takes the label of the nearest pooled feature within `reid_threshold` whose label is not
-    in use. Re-identification reads the video frame."""
+    in use. Re-identification reads the video frame; its XQDA metric is the shipped one, or the file `reid_metric`
+    that `mtt-sim learn-reid` wrote."""
 
     name = "lmb"
     description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
@@ -124,11 +125,19 @@ class LabelledMultiBernoulli(Tracker):
                   "extract": Param(0.5, "(0, 1)"), "prune": Param(1e-3, "[0, 1)"), "max_components": Param(4, "[1, inf)"),
                   "use_low_confidence": Param(True), "low_confidence": Param(0.5), "reid": Param(True),
                   "reid_confidence": Param(0.7), "reid_threshold": Param(5.0, "(0, inf)"),
-                  "pool_per_target": Param(10, "[1, inf)"), "pool_every": Param(10, "[1, inf)")}
+                  "pool_per_target": Param(10, "[1, inf)"), "pool_every": Param(10, "[1, inf)"),
+                  "reid_metric": Param("")}
 
     @property
     def needs_frame(self) -> bool:
         return bool(self.params["reid"])
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        try:
+            self.metric = reid.Metric.from_file(self.params["reid_metric"]) if self.params["reid"] else None
+        except ValueError as err:
+            raise ValueError(f"tracker 'lmb': parameter reid_metric={self.params['reid_metric']!r}: {err}") from None
 
     def reset(self, info=None):
         p = self.params
@@ -142,7 +151,6 @@ class LabelledMultiBernoulli(Tracker):
         self.tracks = _Mixture()
         self.pending = (np.zeros((0, 4)), np.zeros(0))  # births for the next frame: boxes, r_B
         self.next_label, self.frame = 1, 0
-        self.metric = reid.Metric.shipped() if p["reid"] else None
         self.pool = None                      # made at the first frame, sized by its target count
         self.reported: set[int] = set()
 

@@ -117,11 +117,16 @@ class Metric:
                                                    for k in ("mean", "projection", "kernel"))
 
     @classmethod
-    def shipped(cls) -> "Metric":
-        if not METRIC_FILE.exists():
-            raise FileNotFoundError(f"{METRIC_FILE} is missing: run `mtt-sim learn-reid` to make it")
-        with np.load(METRIC_FILE) as f:
-            return cls(dict(f))
+    def from_file(cls, path: str | Path = "") -> "Metric":
+        """The metric saved at `path` by `mtt-sim learn-reid`; the shipped one (METRIC_FILE) by default."""
+        path = Path(path or METRIC_FILE)
+        if not path.is_file():
+            raise ValueError(f"{path} not found: make it with `mtt-sim learn-reid --out {path}`")
+        try:
+            with np.load(path) as f:
+                return cls(dict(f))
+        except (OSError, ValueError, KeyError):
+            raise ValueError(f"{path} is not a metric file written by `mtt-sim learn-reid`") from None
 
     def embed(self, features: np.ndarray) -> np.ndarray:
         return (np.asarray(features, np.float32).reshape(-1, len(self.mean)) - self.mean) @ self.projection
