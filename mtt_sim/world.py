@@ -13,6 +13,7 @@ up the image shrinks and slows down as a real one would.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -145,18 +146,19 @@ class World:
                     jitter = self.rng.normal(0, 0.1, 2) * self.size[slot]
                     self._spawn(gi, self.pos[slot] + jitter, np.zeros(2), carrier=int(slot))
                 continue
-            x0, y0, x1, y1 = np.array(g.region) * np.tile(self.extent, 2)
+            corners = np.array(g.region) * np.tile(self.extent, 2)
             for _ in range(g.count):
-                pos = self._free_spot(g, (x0, y0, x1, y1), grid)
+                pos = self._free_spot(g, (corners[:2], corners[2:]), grid)
                 size = self._spawn(gi, pos, self._initial_velocity(g))
                 grid.add(g.layer, pos, 0.5 * size.max())
         self._flush()
 
     def _free_spot(self, g, region, grid: "_SpotGrid", tries: int = 20) -> np.ndarray:
-        """A point in `region` whose footprint does not overlap a placed target of the same layer, if one is found."""
+        """A point in `region` (its low and high corners) whose footprint does not overlap a placed target of the same
+        layer, if one is found."""
         radius = 0.5 * max(g.size)
         for _ in range(tries):
-            p = self.rng.uniform(region[:2], region[2:])
+            p = self.rng.uniform(*region)
             if grid.is_free(g.layer, p, radius):
                 return p
         return p
@@ -425,15 +427,19 @@ class _SpotGrid:
     def is_free(self, layer: int, p: np.ndarray, radius: float) -> bool:
         """Whether a footprint of `radius` at p keeps clear of every target on `layer` (centre distance above the sum
         of the two half-sizes). Cells are visited nearest first and the test stops at the first overlap."""
-        reach = radius + self.largest.get(layer, 0.0)
-        (x0, y0), (x1, y1) = ((int(v // self.cell) for v in p - reach), (int(v // self.cell) for v in p + reach))
-        cx, cy = (int(v // self.cell) for v in p)
-        cells = sorted(((x, y) for x in range(x0, x1 + 1) for y in range(y0, y1 + 1)),
-                       key=lambda c: abs(c[0] - cx) + abs(c[1] - cy))
-        for x, y in cells:
-            placed = self.cells.get((layer, x, y))
+        rings = int((radius + self.largest.get(layer, 0.0)) // self.cell) + 1  # cells that can hold a touching target
+        cx, cy = int(p[0] // self.cell), int(p[1] // self.cell)
+        for dx, dy in _nearest_first(rings):
+            placed = self.cells.get((layer, cx + dx, cy + dy))
             if placed:
                 rows = np.array(placed)
                 if not (np.hypot(*(rows[:, :2] - p).T) > radius + rows[:, 2]).all():
                     return False
         return True
+
+
+@functools.cache
+def _nearest_first(rings: int) -> list[tuple[int, int]]:
+    """Cell offsets within `rings` of the centre cell, nearest first."""
+    offsets = [(dx, dy) for dx in range(-rings, rings + 1) for dy in range(-rings, rings + 1)]
+    return sorted(offsets, key=lambda d: abs(d[0]) + abs(d[1]))
