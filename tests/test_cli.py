@@ -201,6 +201,9 @@ def test_config_reference_and_perf_report_shape(capsys):
     rows = perf.measure_metrics(repeats=1)
     assert [r["objects"] for r in rows] == [20, 200] and all(r["update_us"] > 0 and r["summary_s"] > 0 for r in rows)
     assert "update / reference" in perf.report_metrics(rows)
+    row = perf.measure_metrics_memory(repeats=1, objects=20, frames=300)
+    assert 0 < row["kb_per_frame"] < 5 and row["summary_s"] > 0 and 1 <= row["peak_over_stored"] < 4
+    assert "stored per frame" in perf.report_metrics_memory(row)
     rows = perf.measure_pf(repeats=1, frames=2)
     assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf"] and all(r["fps"] > 0 for r in rows)
     assert "| ipf (seed 002), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
@@ -211,3 +214,14 @@ def test_sweep_writes_a_plot(tmp_path, capsys):
     assert cli.main(["sweep", "clutter_storm", "--param", "sensor.clutter_rate=0,20", "--trackers", "sort,iou",
                      "--seeds", "2", "--config", "env.max_steps=10", "--plot", str(plot)]) == 0
     assert plot.stat().st_size > 1000 and cv2.imread(str(plot)).shape[2] == 3
+
+
+def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
+    for name in dir(perf):
+        if name.startswith("measure"):
+            monkeypatch.setattr(perf, name, lambda repeats, steps=None, name=name: name)
+        elif name.startswith("report"):
+            monkeypatch.setattr(perf, name, lambda measured: f"table of {measured}")
+    assert cli.main(["perf", "--repeats", "1"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.count("table of measure") == 6 and "measuring" in captured.err
