@@ -233,8 +233,7 @@ def cmd_bench(args) -> int:
     if args.by == "target" and set(args.metric) - {"CentreError", "Coverage"}:
         raise UsageError("--metric", "with --by target: CentreError or Coverage (per-target metrics)")
     title = ",".join(args.scenarios) if args.by == "target" else ""
-    return _grid(args, args.scenarios, overrides, None, lambda records, metric: [
-        _table(records, metric, args.by, title)])
+    return _grid(args, args.scenarios, overrides, None, lambda records, metric: _table(records, metric, args.by, title))
 
 
 def cmd_sweep(args) -> int:
@@ -249,7 +248,7 @@ def cmd_sweep(args) -> int:
         _require("matplotlib", "--plot", "plot")
         _output(args.plot, args.force, "--plot", (".png", ".pdf", ".svg"))
 
-    def tables(records, metric):
+    def table(records, metric) -> str:
         from . import experiment
 
         rows = experiment.summarize(records, metric, by="config")
@@ -258,9 +257,9 @@ def cmd_sweep(args) -> int:
         if args.plot and metric == args.metric[-1] and rows:
             experiment.sweep_plot(rows, key, values, args.plot)
             print(f"plot: {args.plot} ({metric})")
-        return [experiment.markdown(rows, f"{args.scenario}, sweeping {key}")] if rows else []
+        return experiment.markdown(rows, f"{args.scenario}, sweeping {key}") if rows else ""
 
-    return _grid(args, [args.scenario], overrides, [{key: v} for v in values], tables)
+    return _grid(args, [args.scenario], overrides, [{key: v} for v in values], table)
 
 
 def _table(records, metric, by, title) -> str:
@@ -270,8 +269,9 @@ def _table(records, metric, by, title) -> str:
     return experiment.markdown(rows, title) if rows else ""
 
 
-def _grid(args, scenarios: list[str], overrides: dict, configs, tables) -> int:
-    """Run a bench or sweep grid: records written as they finish, tables and a list of failed episodes at the end,
+def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
+    """Run a bench or sweep grid: records written as they finish, a table(records, metric) per metric and the failed
+    episodes at the end,
     and on Ctrl-C or SIGTERM the workers stopped and what finished kept. Exit status: 0, 1 if an episode failed,
     130 if interrupted."""
     out = _output(args.out, args.force, "--out", (".csv", ".json"))
@@ -300,7 +300,7 @@ def _grid(args, scenarios: list[str], overrides: dict, configs, tables) -> int:
     if out and not interrupted:
         experiment.write_records(records, out)  # again, in grid order
     done = [r for r in records if r is not None]
-    print("\n\n".join(t for m in args.metric for t in tables(done, m) if t))
+    print("\n\n".join(filter(None, (table(done, m) for m in args.metric))))
     failed = [r for r in done if r["error"]]
     if failed:
         print(f"\n{len(failed)} of {len(done)} episodes failed:")

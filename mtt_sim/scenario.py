@@ -274,7 +274,7 @@ def _convert(value, tp, key: str, meta: Mapping, where: str):
         fail(f"allowed values: {', '.join(repr(c) for c in meta['choices'])}")
     lo, hi = meta.get("lo"), meta.get("hi")
     if (lo is not None and value < lo) or (hi is not None and value > hi):
-        fail("out of range;" + _range_text(meta))
+        fail("out of range" + _range_text(meta))
     return value
 
 
@@ -290,7 +290,7 @@ def _range_text(meta: Mapping) -> str:
     lo, hi = meta.get("lo"), meta.get("hi")
     if lo is None and hi is None:
         return ""
-    return f" allowed: {'-inf' if lo is None else lo} <= value <= {'inf' if hi is None else hi}"
+    return f"; allowed: {'-inf' if lo is None else lo} <= value <= {'inf' if hi is None else hi}"
 
 
 def _describe(tp) -> str:
@@ -567,7 +567,7 @@ def reference_table() -> str:
             if meta.get("choices"):
                 allowed = ", ".join(repr(c) for c in meta["choices"])
             else:
-                allowed = _range_text(meta).replace(" allowed: ", "")
+                allowed = _range_text(meta).replace("; allowed: ", "")
             rows.append(f"| `{prefix}{f.name}` | `{default!r}` | {meta.get('unit', '')} | {allowed} | {meta.get('doc', '')} |")
 
     walk(Scenario, "")
