@@ -21,6 +21,8 @@ def env_ids() -> dict[str, str]:
 for _key, _id in env_ids().items():
     if _id not in registry:
         register(id=_id, entry_point="mtt_sim.env:TrackingEnv", kwargs={"scenario": _key})
+if "mtt_sim/Replay-v0" not in registry:  # a recorded sequence: gym.make("mtt_sim/Replay-v0", sequence="path/to/folder")
+    register(id="mtt_sim/Replay-v0", entry_point="mtt_sim.env:TrackingEnv", kwargs={"scenario": None})
 
 
 def __getattr__(name: str):

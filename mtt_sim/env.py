@@ -1,8 +1,10 @@
-"""TrackingEnv: the Gymnasium face of the simulator.
+"""TrackingEnv: the Gymnasium face of the simulator, and of recorded sequences.
 
 Each step the agent answers the current observation (frame and detections) with its tracks;
 the environment scores those tracks against the current ground truth, advances the world one
-frame, renders it, runs the detector and returns the next observation.
+frame, renders it, runs the detector and returns the next observation. A recorded MOTChallenge
+sequence (`mtt_sim.sequence`) takes the place of world, renderer and detector: its frames,
+detections and ground truth are read instead of made.
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from gymnasium import spaces
 
 from . import scenario as scn
 from . import viewer
+from .scenario import is_sequence
+from .sequence import Recording
 from .metrics import EpisodeMetrics, FrameStats
 from .overlay import draw_overlay
 from .render import Renderer
@@ -35,7 +39,7 @@ class ActionError(ValueError):
 
 
 class TrackingEnv(gym.Env):
-    """Video multi-target tracking in a simulated scene.
+    """Video multi-target tracking in a simulated scene, or on a recorded sequence.
 
     **Observation** ``Dict(frame=Box(uint8, (H, W, 3)), detections=Box(float32, (max_detections, 5)),
     num_detections=Discrete(max_detections + 1))``: the RGB video frame (absent with
@@ -51,24 +55,40 @@ class TrackingEnv(gym.Env):
     number of ground-truth boxes is MOTA; ``"gospa"`` minus the frame's GOSPA; ``"iou"`` the weighted
     summed similarity of the matches minus weighted FP and FN counts.
 
-    **Episode end** ``terminated`` when no target is alive and none can be born any more;
-    ``truncated`` after ``env.max_steps`` steps.
+    **Episode end** ``terminated`` when no target is alive and none can be born any more (a recorded
+    sequence: after its last frame); ``truncated`` after ``env.max_steps`` steps.
+
+    **Recorded sequences** ``TrackingEnv("path/to/MOT17-02")`` or ``gym.make("mtt_sim/Replay-v0",
+    sequence=...)``: detections as written, in float64, bounded by the extremes of the sequence's det.txt
+    (raw confidences included); action boxes in float64; ground truth scored as TrackEval scores the
+    benchmark (``benchmark=`` overrides the guess from the name and the columns); no gt/: unscored.
 
     **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
-    trackers initialised by hand, and ``image_size`` (width, height). Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
+    trackers initialised by hand, ``image_size`` (width, height), ``frame_rate`` and ``length`` (frames;
+    None for a scenario, which ends when its world does). Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
     num_gt, similarity_sum); on the last step ``info["metrics"]``, the episode's MOTA, IDF1, HOTA, GOSPA
     and the rest (see ``mtt_sim.metrics``). ``env.unwrapped.truth`` is the current ground truth.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 25}  # an instance lists those that work here
 
-    def __init__(self, scenario: str | os.PathLike | scn.Scenario = "crossing", config: Mapping | None = None,
-                 render_mode: str | None = None, obs_mode: str | None = None):
+    def __init__(self, scenario: str | os.PathLike | scn.Scenario | None = "crossing", config: Mapping | None = None,
+                 render_mode: str | None = None, obs_mode: str | None = None, sequence: str | os.PathLike | None = None,
+                 benchmark: str | None = None):
         overrides = scn.expand_dotted(config or {})
         if obs_mode is not None:
             overrides = scn.merge(overrides, {"env": {"obs_mode": obs_mode}})
-        self._source = scenario
-        self.scenario = scn.load(scenario, overrides)
+        source = sequence if sequence is not None else scenario
+        if source is None:
+            raise ValueError("mtt_sim/Replay-v0 needs sequence='path/to/a/MOTChallenge/sequence/folder'")
+        recorded = sequence is not None or (not isinstance(source, scn.Scenario) and is_sequence(source))
+        if benchmark is not None and not recorded:
+            raise ValueError(f"benchmark={benchmark!r} applies to recorded sequences, not to the scenario {source!r}")
+        self.recording = Recording(source, benchmark) if recorded else None
+        if self.recording is not None and not self.recording.scored:
+            gym.logger.warn(f"{source}: no gt/gt.txt, so this env runs unscored (reward 0, no info['metrics'])")
+        self._source = source
+        self.scenario = self._load(overrides)
         self._overrides = overrides
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode={render_mode!r}: allowed values: None, 'rgb_array', 'human'")
@@ -79,23 +99,35 @@ class TrackingEnv(gym.Env):
             raise gym.error.DependencyNotInstalled(viewer.HOW)
         self.render_mode = render_mode
         self._viewer = viewer.Viewer("mtt-sim", self.metadata["render_fps"]) if render_mode == "human" else None
-        self.observation_space, self.action_space = self._spaces(self.scenario)
+        self.observation_space, self.action_space = self._spaces(self.scenario, self.recording)
         self.world: World | None = None
+        self._started = False
         self._done = True
+
+    def _load(self, overrides: Mapping) -> scn.Scenario:
+        return self.recording.scenario(overrides) if self.recording else scn.load(self._source, overrides)
 
     # ------------------------------------------------------------ spaces
 
     @staticmethod
-    def _spaces(sc: scn.Scenario):
+    def _spaces(sc: scn.Scenario, recording: Recording | None = None):
+        """Simulated detections lie in the image with confidences in [0, 1] (float32); recorded ones are given as
+        written (float64), so their bounds are the extremes of the sequence's det.txt (and 0, for padding rows)."""
         w, h = sc.render.width, sc.render.height
         nd, nt = sc.sensor.max_detections, sc.env.max_tracks
-        det_high = np.tile(np.array([w, h, w, h, 1], np.float32), (nd, 1))
-        obs = {"detections": spaces.Box(0.0, det_high, (nd, 5), np.float32), "num_detections": spaces.Discrete(nd + 1)}
+        dtype = np.float32 if recording is None else np.float64
+        if recording is None:
+            det_low, det_high = np.zeros(5), np.array([w, h, w, h, 1.0])
+        else:
+            det_low, det_high = np.minimum(np.floor(recording.det_range[0]), 0), np.maximum(np.ceil(recording.det_range[1]), 0)
+        obs = {"detections": spaces.Box(np.tile(det_low.astype(dtype), (nd, 1)), np.tile(det_high.astype(dtype), (nd, 1)),
+                                        (nd, 5), dtype),
+               "num_detections": spaces.Discrete(nd + 1)}
         if sc.env.obs_mode == "frame+detections":
             obs = {"frame": spaces.Box(0, 255, (h, w, 3), np.uint8), **obs}
-        box_low = np.tile(np.array([-w, -h, 0, 0], np.float32), (nt, 1))  # zero rows pad; used rows need w, h > 0
-        box_high = np.tile(np.array([2 * w, 2 * h, 2 * w, 2 * h], np.float32), (nt, 1))
-        act = {"ids": spaces.Box(0, 2**31 - 1, (nt,), np.int64), "boxes": spaces.Box(box_low, box_high, (nt, 4), np.float32),
+        box_low = np.tile(np.array([-w, -h, 0, 0], dtype), (nt, 1))  # zero rows pad; used rows need w, h > 0
+        box_high = np.tile(np.array([2 * w, 2 * h, 2 * w, 2 * h], dtype), (nt, 1))
+        act = {"ids": spaces.Box(0, 2**31 - 1, (nt,), np.int64), "boxes": spaces.Box(box_low, box_high, (nt, 4), dtype),
                "num_tracks": spaces.Discrete(nt + 1)}
         return spaces.Dict(obs), spaces.Dict(act)
 
@@ -112,30 +144,38 @@ class TrackingEnv(gym.Env):
         sc = self.scenario
         world_rng, render_rng, sensor_rng = (np.random.default_rng(s) for s in
                                             np.random.SeedSequence(self.np_random.integers(2**63)).spawn(3))
-        self.world = World(sc, world_rng)
-        self.renderer = Renderer(sc, render_rng)
-        if sc.render.camera == "follow":
-            self.renderer.camera.follow(self.world)
-        empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
-        self.sensor = make_sensor(sc, sensor_rng, empty)
+        if self.recording is None:
+            self.world = World(sc, world_rng)
+            self.renderer = Renderer(sc, render_rng)
+            if sc.render.camera == "follow":
+                self.renderer.camera.follow(self.world)
+            empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
+            self.sensor = make_sensor(sc, sensor_rng, empty)
+        self._started = True
         s = sc.scoring
         self.metrics = EpisodeMetrics(s.similarity, s.threshold, s.zero_distance, s.gospa_c, s.gospa_p)
         self.steps = 0
         self._done = False
         self._trails: dict[int, deque] = {}
         self._remembered_at = -1
-        self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4), np.float32))
+        self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4)))
         obs = self.observe()
-        seen = self.truth.visibility > 0
-        info = {"frame_index": 0, "init_ids": self.truth.ids[seen].copy(), "init_boxes": self.truth.boxes[seen].copy(),
-                "image_size": (sc.render.width, sc.render.height)}
+        if self.recording is None:
+            seen = self.truth.visibility > 0
+            init_ids, init_boxes = self.truth.ids[seen].copy(), self.truth.boxes[seen].copy()
+            rate, length = float(self.metadata["render_fps"]), None
+        else:
+            init_ids, init_boxes, _ = self.recording.scoring(0, np.zeros((0, 4)))
+            rate, length = self.recording.info.frame_rate, len(self.recording)
+        info = {"frame_index": 0, "init_ids": init_ids, "init_boxes": init_boxes,
+                "image_size": (sc.render.width, sc.render.height), "frame_rate": rate, "length": length}
         if self._viewer:
             self.render()
         return obs, info
 
     def _reconfigure(self, config: Mapping):
         overrides = scn.merge(self._overrides, scn.expand_dotted(config))
-        new = scn.load(self._source, overrides)
+        new = self._load(overrides)
         changed = [k for k in _SPACE_KEYS if _get(new, k) != _get(self.scenario, k)]
         if changed:
             raise ValueError(f"reset(options={{'config': ...}}) cannot change {', '.join(changed)}: the observation and "
@@ -147,18 +187,23 @@ class TrackingEnv(gym.Env):
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self.remember_tracks(ids, boxes)
-        scored = self.truth.visibility >= self.scenario.scoring.min_visibility
-        stats = self.metrics.update(self.truth.ids[scored], self.truth.boxes[scored], ids, boxes)
-        reward = self._reward(stats)
-        self.world.step()
-        self.renderer.camera.advance(self.world)
+        if self.recording is None:
+            scored = self.truth.visibility >= self.scenario.scoring.min_visibility
+            gt_ids, gt_boxes, kept = self.truth.ids[scored], self.truth.boxes[scored], slice(None)
+        else:
+            gt_ids, gt_boxes, kept = self.recording.scoring(self.steps, boxes)
+        stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept])
+        reward = self._reward(stats) if self.recording is None or self.recording.scored else 0.0
+        if self.recording is None:
+            self.world.step()
+            self.renderer.camera.advance(self.world)
         self.steps += 1
         obs = self.observe()
-        terminated = bool(self.world.finished)
+        terminated = bool(self.world.finished) if self.recording is None else self.steps >= len(self.recording)
         truncated = bool(self.steps >= self.scenario.env.max_steps and not terminated)
         self._done = terminated or truncated
         info = {"frame_index": self.steps, "frame": dict(vars(stats))}
-        if self._done:
+        if self._done and (self.recording is None or self.recording.scored):
             info["metrics"] = self.metrics.summary()
         if self._viewer:
             self.render()
@@ -173,22 +218,35 @@ class TrackingEnv(gym.Env):
         return s.iou_weight * stats.similarity_sum - s.fp_weight * stats.fp - s.fn_weight * stats.fn
 
     def observe(self) -> dict[str, Any]:
-        """Render, measure the truth and detect for the world as it is now (after reset/step, or after `world.place`)."""
+        """Render, measure the truth and detect for the world as it is now (after reset/step, or after `world.place`);
+        for a recorded sequence, read its current frame (after the last one: no detections and a black frame)."""
         sc = self.scenario
         want_frame = sc.env.obs_mode == "frame+detections" or sc.sensor.model == "foreground" or self.render_mode
-        frame, labels, boxes = self.renderer.render(self.world, draw_frame=bool(want_frame))
-        w = self.world
-        self.frame, self.labels = frame, labels
-        self.truth: Truth = measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group],
-                                    self.renderer.occluder_image_boxes(), self.renderer.occluder_depth)
-        self.detections: Detections = self.sensor.detect(self.truth, labels, frame)
-        rows = self.detections.rows
-        padded = np.zeros((sc.sensor.max_detections, 5), np.float32)
+        if self.recording is not None:
+            self._read(bool(want_frame))
+        else:
+            frame, labels, boxes = self.renderer.render(self.world, draw_frame=bool(want_frame))
+            w = self.world
+            self.frame, self.labels = frame, labels
+            self.truth: Truth = measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group],
+                                        self.renderer.occluder_image_boxes(), self.renderer.occluder_depth)
+            self.detections: Detections = self.sensor.detect(self.truth, labels, frame)
+        rows, frame = self.detections.rows, self.frame
+        padded = np.zeros((sc.sensor.max_detections, 5), self.observation_space["detections"].dtype)
         padded[: len(rows)] = rows
         obs = {"detections": padded, "num_detections": np.int64(len(rows))}
         if sc.env.obs_mode == "frame+detections":
             obs = {"frame": frame, **obs}
         return obs
+
+    def _read(self, want_frame: bool) -> None:
+        """The recorded sequence's current frame: truth, detections and (if wanted) the image."""
+        rec, k = self.recording, self.steps
+        self.truth, rows = rec.truth(k), rec.detections(k)
+        self.frame = rec.image(k) if want_frame and rec.has_images and k < len(rec) else None
+        if want_frame and self.frame is None:  # past the end, or a sequence without images being rendered
+            self.frame = np.zeros((self.scenario.render.height, self.scenario.render.width, 3), np.uint8)
+        self.detections = Detections(rows, np.full(len(rows), -1, np.int64))
 
     # ------------------------------------------------------------ actions
 
@@ -215,7 +273,7 @@ class TrackingEnv(gym.Env):
             raise ActionError(f"unpadded action: 'ids' must have shape (n,) and 'boxes' (n, 4) with n <= {nt}, got "
                               f"{ids.shape} and {boxes.shape}")
         if not ids.size:
-            return np.zeros(0, np.int64), np.zeros((0, 4), np.float32)
+            return np.zeros(0, np.int64), np.zeros((0, 4), self.action_space["boxes"].dtype)
         if not np.issubdtype(ids.dtype, np.integer):
             raise ActionError(f"action['ids'] must be integers, got dtype {ids.dtype}")
         if not np.issubdtype(boxes.dtype, np.number) or np.iscomplexobj(boxes):
@@ -225,7 +283,7 @@ class TrackingEnv(gym.Env):
         if out.any():
             raise ActionError(f"action['ids'] {ids[out][0]} is outside 0..{int(space.high[0])}")
         with np.errstate(over="ignore"):
-            boxes = boxes.astype(np.float32)
+            boxes = boxes.astype(self.action_space["boxes"].dtype)
         bad = ~np.isfinite(boxes).all(axis=1)
         if bad.any():
             raise ActionError(f"action['boxes'] row {int(np.flatnonzero(bad)[0])} is not finite as float32: "
@@ -252,7 +310,7 @@ class TrackingEnv(gym.Env):
         if self._remembered_at == self.steps:
             return
         self._remembered_at = self.steps
-        ids, boxes = np.asarray(ids, np.int64), np.asarray(boxes, np.float32).reshape(-1, 4)
+        ids, boxes = np.asarray(ids, np.int64), np.asarray(boxes, float).reshape(-1, 4)
         self._last_tracks = (ids, boxes)
         centres = boxes[:, :2] + boxes[:, 2:] / 2
         for i, c in zip(ids.tolist(), centres):
@@ -266,7 +324,7 @@ class TrackingEnv(gym.Env):
     def render(self):
         """rgb_array: the frame with ground truth, detections and the last tracks drawn on; human: show it in a window
         (which reset and step also do)."""
-        if self.world is None:
+        if not self._started:
             raise RuntimeError("render() needs reset() first")
         if self.render_mode is None:
             gym.logger.warn("render() called with render_mode=None; make the env with render_mode='rgb_array'")

@@ -21,7 +21,8 @@ import numpy as np
 from tqdm import tqdm
 
 from .env import NO_TRACKS, TrackingEnv
-from .metrics import evaluate
+from .metrics import EpisodeMetrics
+from .sequence import Recording, by_frame, check_frames, read_rows
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
            config: Mapping | None = None, progress: bool = False) -> dict:
@@ -67,55 +68,29 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
 
 
 def _write_rows(path: Path, rows) -> None:
-    """Comma-separated rows; floats with 9 significant digits, enough to give back a float32 box exactly."""
-    path.write_text("".join(",".join(f"{v:.9g}" if isinstance(v, float) else str(v) for v in r) + "\n" for r in rows))
-
-
-def sequence_length(folder: str | Path) -> int:
-    info = configparser.ConfigParser()
-    if not info.read(Path(folder) / "seqinfo.ini"):
-        raise FileNotFoundError(f"{Path(folder) / 'seqinfo.ini'}: not found; is {folder} a MOTChallenge sequence?")
-    return int(info["Sequence"]["seqLength"])
-
-
-def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
-    """A MOTChallenge text file as a float array (rows, columns), with a clear error for a malformed one."""
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"{path}: not found")
-    text = path.read_text().strip()
-    if not text:
-        return np.zeros((0, min_columns))
-    try:
-        rows = np.array([[float(v) for v in line.replace(" ", "").split(",")] for line in text.splitlines()])
-    except ValueError as err:
-        raise ValueError(f"{path}: not a comma-separated MOTChallenge file ({err})") from None
-    if rows.ndim != 2 or rows.shape[1] < min_columns:
-        raise ValueError(f"{path}: every row needs at least {min_columns} comma-separated values "
-                         "(frame, id, x, y, w, h, ...)")
-    if not np.isfinite(rows[:, :6]).all():
-        raise ValueError(f"{path}: row {int(np.flatnonzero(~np.isfinite(rows[:, :6]).all(1))[0]) + 1} is not finite")
-    return rows
+    """Comma-separated rows; floats in their shortest form that reads back exactly (a float32 box or a float64 one)."""
+    path.write_text("".join(",".join(repr(v) if isinstance(v, float) else str(v) for v in r) + "\n" for r in rows))
 
 
 def per_frame(rows: np.ndarray, frames: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """(ids, boxes) for frames 1..frames from rows (frame, id, x, y, w, h, ...)."""
-    frame = rows[:, 0].astype(int)
-    order = np.argsort(frame, kind="stable")
-    rows, frame = rows[order], frame[order]
-    bounds = np.searchsorted(frame, np.arange(1, frames + 2))
+    rows, bounds = by_frame(rows, frames)
     return [(rows[a:b, 1].astype(np.int64), rows[a:b, 2:6]) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def evaluate_results(gt_folder: str | Path, results: str | Path, **scoring) -> dict:
-    """Our metrics of a results file against a sequence's ground truth (its considered rows)."""
-    frames = sequence_length(gt_folder)
-    gt = read_rows(Path(gt_folder) / "gt" / "gt.txt", 7)
-    res = read_rows(results, 6)
-    late = res[:, 0] > frames
-    if late.any() or (res[:, 0] < 1).any():
-        raise ValueError(f"{results}: frame numbers must lie in 1..{frames} (the sequence's length)")
-    return evaluate(per_frame(gt[gt[:, 6] > 0], frames), per_frame(res, frames), **scoring)
+def evaluate_results(sequence_folder: str | Path, results: str | Path, benchmark: str | None = None, **scoring) -> dict:
+    """Our metrics of a results file against a sequence's ground truth, scored as TrackEval scores the sequence's
+    benchmark (see `mtt_sim.sequence`): the same numbers the env gives for the same tracks."""
+    recording = Recording(sequence_folder, benchmark)
+    if not recording.scored:
+        raise FileNotFoundError(f"{Path(sequence_folder) / 'gt' / 'gt.txt'}: not found; there is no ground truth to score")
+    rows = read_rows(results, 6)
+    check_frames(Path(results), rows, len(recording))
+    metrics = EpisodeMetrics(**scoring)
+    for k, (ids, boxes) in enumerate(per_frame(rows, len(recording))):
+        gt_ids, gt_boxes, scored = recording.scoring(k, boxes)
+        metrics.update(gt_ids, gt_boxes, ids[scored], boxes[scored])
+    return metrics.summary()
 
 
 def write_results(path: str | Path, tracks_per_frame) -> None:

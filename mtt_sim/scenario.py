@@ -432,9 +432,21 @@ def shipped_names() -> dict[str, str]:
             for p in sorted(scenario_dir().iterdir(), key=lambda p: p.name) if p.name.endswith(".toml")}
 
 
+def is_sequence(path) -> bool:
+    """Whether `path` is a folder laid out as a MOTChallenge sequence (seqinfo.ini, det/det.txt or gt/gt.txt)."""
+    p = Path(path)
+    return p.is_dir() and any((p / f).is_file() for f in ("seqinfo.ini", "det/det.txt", "gt/gt.txt"))
+
+
 def resolve(name: str | Path) -> str | Path:
-    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml path is
-    returned as a Path. An unknown name gets the list of keys and, for a near miss, a suggestion."""
+    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml file or a
+    recorded sequence's folder is returned as a Path. An unknown name gets the list of keys and, for a near miss, a
+    suggestion."""
+    if Path(name).is_dir():
+        if not is_sequence(name):
+            raise ConfigError(f"{str(name)!r} is a folder but not a MOTChallenge sequence (no seqinfo.ini, det/det.txt "
+                              "or gt/gt.txt in it)")
+        return Path(name)
     if isinstance(name, Path) or str(name).endswith(".toml"):
         if not Path(name).is_file():
             raise ConfigError(f"scenario file {str(name)!r}: not found")
@@ -446,7 +458,7 @@ def resolve(name: str | Path) -> str | Path:
         return spellings[typed]
     near = difflib.get_close_matches(typed, spellings, n=1, cutoff=0.7)
     raise ConfigError(f"unknown scenario {str(name)!r}" + (f" (did you mean {spellings[near[0]]!r}?)" if near else "")
-                      + f"; available: {', '.join(keys)} (in any case, or their env ids, or a .toml file)")
+                      + f"; available: {', '.join(keys)} (in any case, or their env ids, a .toml file or a sequence folder)")
 
 
 def load_raw(key_or_path: str | Path) -> tuple[dict, str]:
@@ -535,6 +547,10 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
     """Load a shipped scenario (by key), a TOML file or an existing Scenario, with optional overrides."""
     if isinstance(key_or_path, Scenario):
         raw, where = to_mapping(key_or_path), f"scenario {key_or_path.name}"
+    elif is_sequence(key_or_path):
+        from .sequence import Recording  # here: the recorded source builds on this module
+
+        return Recording(key_or_path).scenario(overrides)
     else:
         raw, where = load_raw(key_or_path)
     if overrides:

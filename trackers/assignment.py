@@ -19,6 +19,41 @@ def iou_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return inter / np.maximum(union, 1e-12)
 
 
+def corner_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """IoU (len(a), len(b)) of boxes x1, y1, x2, y2, computed as the SORT reference code does."""
+    w = np.maximum(0.0, np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]))
+    h = np.maximum(0.0, np.minimum(a[:, None, 3], b[:, 3]) - np.maximum(a[:, None, 1], b[:, 1]))
+    wh = w * h
+    area_a, area_b = (a[:, 2] - a[:, 0]) * (a[:, 3] - a[:, 1]), (b[:, 2] - b[:, 0]) * (b[:, 3] - b[:, 1])
+    return wh / (area_a[:, None] + area_b - wh)
+
+
+def plus_one_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """IoU (len(a), len(b)) of boxes x1, y1, x2, y2 counting pixels inclusively (a box from 0 to 9 is 10 wide), as
+    cython_bbox's bbox_overlaps computes it for ByteTrack."""
+    iw = np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]) + 1
+    ih = np.minimum(a[:, None, 3], b[:, 3]) - np.maximum(a[:, None, 1], b[:, 1]) + 1
+    area_a, area_b = (a[:, 2] - a[:, 0] + 1) * (a[:, 3] - a[:, 1] + 1), (b[:, 2] - b[:, 0] + 1) * (b[:, 3] - b[:, 1] + 1)
+    overlap = (iw > 0) & (ih > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(overlap, iw * ih / (area_a[:, None] + area_b - iw * ih), 0.0)
+
+
+def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(matches (k, 2) sorted by row, unmatched rows, unmatched cols) of the minimum-cost assignment of a rectangular
+    `cost`, where leaving a row or a column unassigned costs limit / 2: what lap.lapjv(cost, extend_cost=True,
+    cost_limit=limit) finds, as the SORT and ByteTrack reference codes call it. It is `lap` that is called (not
+    scipy), because among equal-cost assignments the reference outputs depend on the one it picks."""
+    import lap  # imported here: only these two baselines need it
+
+    n, m = cost.shape
+    if not cost.size:
+        return np.zeros((0, 2), np.intp), np.arange(n), np.arange(m)
+    _, x, y = lap.lapjv(cost, extend_cost=True, **({} if np.isinf(limit) else {"cost_limit": limit}))
+    rows = np.flatnonzero(x >= 0)
+    return np.stack([rows, x[rows]], axis=1), np.flatnonzero(x < 0), np.flatnonzero(y < 0)
+
+
 def chi2_gate(dim: int, probability: float = 0.99) -> float:
     """The squared-Mahalanobis gate that a true measurement passes with `probability`."""
     return float(chdtri(dim, 1.0 - probability))  # chi2.ppf(probability, dim), without importing scipy.stats

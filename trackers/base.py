@@ -16,7 +16,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Tracks:
-    """A tracker's output for one frame: ids (m,), boxes (m, 4) x, y, w, h, scores (m,)."""
+    """A tracker's output for one frame: ids (m,), boxes (m, 4) x, y, w, h (float64, as computed), scores (m,)."""
 
     ids: np.ndarray
     boxes: np.ndarray
@@ -25,26 +25,26 @@ class Tracks:
     @classmethod
     def of(cls, ids, boxes, scores=None) -> "Tracks":
         ids = np.asarray(ids, np.int64).reshape(-1)
-        boxes = np.asarray(boxes, np.float32).reshape(-1, 4)
-        scores = np.ones(len(ids), np.float32) if scores is None else np.asarray(scores, np.float32).reshape(-1)
+        boxes = np.asarray(boxes, np.float64).reshape(-1, 4)
+        scores = np.ones(len(ids)) if scores is None else np.asarray(scores, np.float64).reshape(-1)
         return cls(ids, boxes, scores)
 
     def __len__(self) -> int:
         return len(self.ids)
 
     def to_action(self, action_space=None) -> dict:
-        """The env action: padded to `action_space` (a gymnasium Dict space) when given, else unpadded.
-
-        Boxes with a non-positive side are dropped: a box must have an area to be scored.
-        """
-        ok = (self.boxes[:, 2] > 0) & (self.boxes[:, 3] > 0) & np.isfinite(self.boxes).all(axis=1)
-        ids, boxes = self.ids[ok], self.boxes[ok]
+        """The env action: padded to `action_space` (a gymnasium Dict space), in its box dtype, when given; else
+        unpadded. Boxes with a non-positive side in that dtype are dropped: a box must have an area to be scored."""
+        with np.errstate(over="ignore"):
+            boxes = self.boxes if action_space is None else self.boxes.astype(action_space["boxes"].dtype)
+        ok = (boxes[:, 2] > 0) & (boxes[:, 3] > 0) & np.isfinite(boxes).all(axis=1)
+        ids, boxes = self.ids[ok], boxes[ok]
         if action_space is None:
             return {"ids": ids, "boxes": boxes}
         size = action_space["ids"].shape[0]
         if len(ids) > size:
             raise ValueError(f"{len(ids)} tracks do not fit the action space's {size} rows (env.max_tracks)")
-        padded_ids, padded_boxes = np.zeros(size, np.int64), np.zeros((size, 4), np.float32)
+        padded_ids, padded_boxes = np.zeros(size, np.int64), np.zeros((size, 4), boxes.dtype)
         padded_ids[: len(ids)], padded_boxes[: len(ids)] = ids, boxes
         return {"ids": padded_ids, "boxes": padded_boxes, "num_tracks": len(ids)}
 
@@ -187,6 +187,11 @@ class Tracker:
 
     def update(self, obs: Mapping) -> Tracks:
         raise NotImplementedError
+
+    def results(self, online: list[Tracks]) -> list[Tracks]:
+        """The tracks of every frame for a results file, given those it reported online: the same for an online method;
+        an offline one (the IOU tracker) gives its own."""
+        return online
 
     def debug(self) -> list[dict]:
         """Drawable internals of the last update for overlays, as plain dicts with a "kind": "ellipse" (center,

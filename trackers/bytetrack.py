@@ -1,66 +1,176 @@
-"""ByteTrack (Zhang et al. 2022): associate every detection box, low-confidence ones in a second round."""
+"""ByteTrack (Zhang et al. 2022): associate every detection box, low-confidence ones in a second round; as the
+reference code ifzhang/ByteTrack (yolox/tracker, commit d1bf019) computes it."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .assignment import assign, iou_matrix
+from .assignment import lapjv, plus_one_iou
 from .base import Param, Tracker, Tracks, detections, register
-from .kalman import KalmanBank, box_model, boxes_to_z, stop_shrinking_to_nothing, z_to_boxes
-from .trackbook import CONFIRMED, LOST, TENTATIVE, TrackBook
+from .kalman import xyah_initiate, xyah_predict, xyah_update
+
+TRACKED, LOST, REMOVED = 1, 2, 3  # the reference's TrackState (New = 0 is never stored)
 
 
 @register
 class ByteTrack(Tracker):
-    """Detections split at track_thresh into high and low (down to low_thresh). First, confirmed and lost tracks
-    are matched to high detections (IoU distance <= match_thresh); second, the still-unmatched confirmed tracks
-    are matched to low detections (<= second_match_thresh), which recovers occluded, low-scored targets instead
-    of discarding them; unmatched confirmed tracks become lost and are kept for track_buffer frames. Tentative
-    tracks (born last frame) take the remaining high detections (<= unconfirmed_match_thresh) or die; high
-    detections left start tentative tracks if their score reaches new_track_thresh. Reported: confirmed
-    tracks matched this frame. Plain IoU distances and SORT's Kalman box model stand in for the paper's
-    score-fused IoU and (x, y, aspect, h) filter."""
+    """Detections above track_thresh are high, those between 0.1 and track_thresh low. Tracked and lost tracks
+    (lost ones with their height velocity zeroed) predict with a Kalman filter on (cx, cy, aspect, height) whose noise
+    scales with the height, and take high detections (cost 1 - IoU x score, at most match_thresh); tracked tracks
+    left take low detections (1 - IoU, at most 0.5) or become lost; tracks born last frame take the remaining high
+    detections (1 - IoU x score, at most 0.7) or are removed; high detections left with a score of track_thresh + 0.1
+    start tracks, reported from their second match (from the first frame at once). Lost tracks are removed after
+    int(frame_rate / 30 x track_buffer) frames; a tracked and a lost track overlapping by IoU > 0.85 keep the older.
+    IoU counts pixels inclusively (+1), as cython_bbox does, and assignments come from `lap` with a cost limit, as in
+    the reference; its list order is kept throughout, so ids and boxes agree with its output. mot20=true leaves out
+    the score in the costs, as the reference does for MOT20."""
 
     name = "bytetrack"
     description = "ByteTrack (Zhang et al. 2022): two-stage association with high- and low-confidence detections"
-    parameters = {"track_thresh": Param(0.5), "low_thresh": Param(0.1), "new_track_thresh": Param(0.6),
-                  "match_thresh": Param(0.8, "[0, 1]"), "second_match_thresh": Param(0.5, "[0, 1]"),
-                  "unconfirmed_match_thresh": Param(0.7, "[0, 1]"), "track_buffer": Param(30, "[0, inf)")}
+    parameters = {"track_thresh": Param(0.5), "track_buffer": Param(30, "[0, inf)"), "match_thresh": Param(0.8, "[0, 1]"),
+                  "mot20": Param(False), "frame_rate": Param(30.0, "(0, inf)")}
 
     def reset(self, info=None):
-        self.book = TrackBook(KalmanBank(box_model()))
-        self.frame = 0
-
-    def _match(self, rows: np.ndarray, dets: np.ndarray, free: np.ndarray, max_distance: float) -> np.ndarray:
-        """Match tracks `rows` to the free detections; update the matched ones; return the matched rows."""
-        cols = np.flatnonzero(free)
-        matches, _, _ = assign(1 - iou_matrix(z_to_boxes(self.book.kf.x[rows]), dets[cols, :4]), max_distance)
-        r, c = rows[matches[:, 0]], cols[matches[:, 1]]
-        self.book.hit(r, dets[c, :4], dets[c, 4], boxes_to_z(dets[c, :4]))
-        free[c] = False
-        return r
+        self.mean, self.cov = np.zeros((0, 8)), np.zeros((0, 8, 8))
+        self.ids, self.state = np.zeros(0, np.int64), np.zeros(0, np.int8)
+        self.activated = np.zeros(0, bool)
+        self.score = np.zeros(0)
+        self.last_frame, self.start_frame = np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.tracked: list[int] = []  # rows, in the reference's list order
+        self.lost: list[int] = []
+        self.removed_ids: set[int] = set()
+        self.frame, self.next_id = 0, 1
 
     def update(self, obs) -> Tracks:
-        p, book = self.params, self.book
+        p = self.params
         dets = detections(obs)
         self.frame += 1
-        high = dets[dets[:, 4] >= p["track_thresh"]]
-        low = dets[(dets[:, 4] >= p["low_thresh"]) & (dets[:, 4] < p["track_thresh"])]
-        stop_shrinking_to_nothing(book.kf)
-        book.predict()
-        free_high, free_low = np.ones(len(high), bool), np.ones(len(low), bool)
-        pool = np.flatnonzero(book.state != TENTATIVE)
-        first = self._match(pool, high, free_high, p["match_thresh"])
-        book.state[first] = CONFIRMED
-        tracked = np.setdiff1d(pool[book.state[pool] == CONFIRMED], first)
-        second = self._match(tracked, low, free_low, p["second_match_thresh"])
-        book.state[np.setdiff1d(tracked, second)] = LOST
-        new = np.flatnonzero(book.state == TENTATIVE)
-        confirmed = self._match(new, high, free_high, p["unconfirmed_match_thresh"])
-        book.state[confirmed] = CONFIRMED
-        dead = ((book.state == TENTATIVE) & (book.misses > 0)) | ((book.state == LOST) & (book.misses > p["track_buffer"]))
-        book.keep(~dead)
-        born = high[free_high & (high[:, 4] >= p["new_track_thresh"])]
-        book.add(born[:, :4], born[:, 4], boxes_to_z(born[:, :4]), state=CONFIRMED if self.frame == 1 else TENTATIVE)
-        report = (book.state == CONFIRMED) & (book.misses == 0)
-        return Tracks.of(book.ids[report], z_to_boxes(book.kf.x[report]), book.score[report])
+        corners = np.c_[dets[:, :2], dets[:, :2] + dets[:, 2:4]]  # the reference is given x1, y1, x2, y2
+        tlwh = np.c_[corners[:, :2], corners[:, 2:] - corners[:, :2]]
+        score = dets[:, 4]
+        high = np.flatnonzero(score > p["track_thresh"])
+        low = np.flatnonzero((score > 0.1) & (score < p["track_thresh"]))
+        unconfirmed = [r for r in self.tracked if not self.activated[r]]
+        pool = _joint([r for r in self.tracked if self.activated[r]], self.lost)
+        self._predict(pool)
+        activated, refound, lost_now, removed_now = [], [], [], []
+
+        # first association: tracked and lost tracks with the high detections
+        matches, left_tracks, left_high = self._associate(pool, tlwh[high], score[high], p["match_thresh"])
+        for t, d in matches:
+            (activated if self.state[pool[t]] == TRACKED else refound).append(pool[t])
+            self._correct(pool[t], tlwh[high[d]], score[high[d]])
+        # second association: tracked tracks left with the low detections
+        rest = [pool[t] for t in left_tracks if self.state[pool[t]] == TRACKED]
+        matches, still, _ = self._associate(rest, tlwh[low], None, 0.5)
+        for t, d in matches:
+            activated.append(rest[t])
+            self._correct(rest[t], tlwh[low[d]], score[low[d]])
+        for t in still:
+            if self.state[rest[t]] != LOST:
+                self.state[rest[t]] = LOST
+                lost_now.append(rest[t])
+        # tracks born last frame with the high detections left
+        high = high[left_high]
+        matches, left_new, left_high = self._associate(unconfirmed, tlwh[high], score[high], 0.7)
+        for t, d in matches:
+            activated.append(unconfirmed[t])
+            self._correct(unconfirmed[t], tlwh[high[d]], score[high[d]])
+        for t in left_new:
+            self.state[unconfirmed[t]] = REMOVED
+            removed_now.append(unconfirmed[t])
+        # new tracks
+        born = high[left_high]
+        born = born[score[born] >= p["track_thresh"] + 0.1]
+        activated += self._start(tlwh[born], score[born])
+        # lost too long
+        for r in self.lost:
+            if self.frame - self.last_frame[r] > int(p["frame_rate"] / 30.0 * p["track_buffer"]):
+                self.state[r] = REMOVED
+                removed_now.append(r)
+        self._rearrange(activated, refound, lost_now, removed_now)
+        out = [r for r in self.tracked if self.activated[r]]
+        return Tracks.of(self.ids[out], self._tlwh(out), self.score[out])
+
+    def _tlwh(self, rows) -> np.ndarray:
+        """Boxes x, y, w, h of track rows, from their means (cx, cy, aspect, height)."""
+        m = self.mean[rows]
+        w = m[:, 2] * m[:, 3]
+        return np.stack([m[:, 0] - w / 2, m[:, 1] - m[:, 3] / 2, w, m[:, 3]], axis=1)
+
+    def _predict(self, rows: list[int]) -> None:
+        if rows:
+            mean = self.mean[rows].copy()
+            mean[self.state[rows] != TRACKED, 7] = 0
+            self.mean[rows], self.cov[rows] = xyah_predict(mean, self.cov[rows])
+
+    def _associate(self, rows: list[int], tlwh: np.ndarray, score: np.ndarray | None, limit: float):
+        """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks
+        `rows` and detections by 1 - IoU (times the score unless mot20 or `score` is None), capped at `limit`."""
+        boxes = self._tlwh(rows)
+        cost = 1 - plus_one_iou(np.c_[boxes[:, :2], boxes[:, :2] + boxes[:, 2:]],
+                                np.c_[tlwh[:, :2], tlwh[:, :2] + tlwh[:, 2:]])
+        if score is not None and not self.params["mot20"] and cost.size:
+            cost = 1 - (1 - cost) * score[None, :]
+        return lapjv(cost, limit)
+
+    def _correct(self, row: int, tlwh: np.ndarray, score: float) -> None:
+        """A match: the filter is corrected and the track is tracked and activated (re-found, if it was lost)."""
+        z = np.r_[tlwh[:2] + tlwh[2:] / 2, tlwh[2] / tlwh[3], tlwh[3]]
+        mean, cov = xyah_update(self.mean[row:row + 1], self.cov[row:row + 1], z[None])
+        self.mean[row], self.cov[row] = mean[0], cov[0]
+        self.state[row], self.activated[row], self.score[row], self.last_frame[row] = TRACKED, True, score, self.frame
+
+    def _start(self, tlwh: np.ndarray, score: np.ndarray) -> list[int]:
+        """New tracks (rows appended), activated at once only in the first frame."""
+        n = len(tlwh)
+        z = np.c_[tlwh[:, :2] + tlwh[:, 2:] / 2, tlwh[:, 2] / tlwh[:, 3], tlwh[:, 3]]
+        mean, cov = xyah_initiate(z)
+        first = len(self.ids)
+        self.mean, self.cov = np.r_[self.mean, mean], np.r_[self.cov, cov]
+        self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + n)]
+        self.next_id += n
+        self.state = np.r_[self.state, np.full(n, TRACKED, np.int8)]
+        self.activated = np.r_[self.activated, np.full(n, self.frame == 1)]
+        self.score = np.r_[self.score, score]
+        self.last_frame = np.r_[self.last_frame, np.full(n, self.frame)]
+        self.start_frame = np.r_[self.start_frame, np.full(n, self.frame)]
+        return list(range(first, first + n))
+
+    def _rearrange(self, activated, refound, lost_now, removed_now) -> None:
+        """The reference's list bookkeeping at the end of a frame, in its order (ids and duplicates depend on it)."""
+        tracked = _joint(_joint([r for r in self.tracked if self.state[r] == TRACKED], activated), refound)
+        lost = [r for r in self.lost if r not in set(tracked)] + lost_now
+        lost = [r for r in lost if int(self.ids[r]) not in self.removed_ids]
+        self.removed_ids.update(int(self.ids[r]) for r in removed_now)
+        self.tracked, self.lost = self._without_duplicates(tracked, lost)
+        self._compact()
+
+    def _without_duplicates(self, tracked: list[int], lost: list[int]) -> tuple[list[int], list[int]]:
+        """A tracked and a lost track with 1 - IoU < 0.15: the one that has been tracked for fewer frames goes."""
+        if not tracked or not lost:
+            return tracked, lost
+        a, b = self._tlwh(tracked), self._tlwh(lost)
+        close = np.argwhere(1 - plus_one_iou(np.c_[a[:, :2], a[:, :2] + a[:, 2:]], np.c_[b[:, :2], b[:, :2] + b[:, 2:]])
+                            < 0.15)
+        age = self.last_frame - self.start_frame
+        drop_a = {p for p, q in close if not age[tracked[p]] > age[lost[q]]}
+        drop_b = {q for p, q in close if age[tracked[p]] > age[lost[q]]}
+        return ([r for i, r in enumerate(tracked) if i not in drop_a], [r for i, r in enumerate(lost) if i not in drop_b])
+
+    def _compact(self) -> None:
+        """Drop the rows of tracks in neither list (their ids stay in removed_ids), keeping the lists' order."""
+        alive = self.tracked + self.lost
+        if len(self.ids) < 2 * len(alive) + 64:
+            return
+        keep = np.array(sorted(alive), np.intp)
+        new_row = np.full(len(self.ids), -1)
+        new_row[keep] = np.arange(len(keep))
+        for name in ("mean", "cov", "ids", "state", "activated", "score", "last_frame", "start_frame"):
+            setattr(self, name, getattr(self, name)[keep])
+        self.tracked, self.lost = [int(new_row[r]) for r in self.tracked], [int(new_row[r]) for r in self.lost]
+
+
+def _joint(a: list[int], b: list[int]) -> list[int]:
+    """The reference's joint_stracks: the rows of `a`, then those of `b` not in `a`."""
+    return a + [r for r in dict.fromkeys(b) if r not in set(a)]

@@ -4,18 +4,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import iou_matrix
+from .assignment import corner_iou
 from .base import Param, Tracker, Tracks, detections, register
-from .trackbook import TrackBook
+
+
+def _corners(boxes: np.ndarray) -> np.ndarray:
+    return np.c_[boxes[:, :2], boxes[:, :2] + boxes[:, 2:4]]
 
 
 @register
 class IouTracker(Tracker):
-    """Detections under sigma_l are dropped; each active track, in order, takes the remaining detection that
-    overlaps its last box most if that IoU reaches sigma_iou, otherwise it ends; unused detections start tracks.
-    The paper keeps a finished track only if it lasted t_min frames and its best score reached sigma_h; online,
-    a track is reported from the frame it meets both conditions (the paper, being offline, also reports its
-    earlier frames)."""
+    """As the reference code (bochinski/iou-tracker, `track_iou`): detections under sigma_l are dropped; each active
+    track, in order, takes the remaining detection that overlaps its last box most if that IoU reaches sigma_iou,
+    otherwise it ends; unused detections start tracks. A track is kept if it lasted t_min frames and its best score
+    reached sigma_h. The method is offline: it reports a kept track in every frame from its first. Online (the env's
+    reward and metrics) a track is reported from the frame it meets both conditions; `results()`, which files are
+    written from, gives the offline output, numbered in the reference's order. Coordinates stay as given (the
+    reference reads them as float32 shifted by one pixel, which its writer shifts back)."""
 
     name = "iou"
     description = "IOU tracker (Bochinski et al. 2017): greedy IoU linking with sigma_l, sigma_h, sigma_iou, t_min"
@@ -23,24 +28,47 @@ class IouTracker(Tracker):
                   "t_min": Param(2, "[1, inf)")}
 
     def reset(self, info=None):
-        self.book = TrackBook()
+        self.key = np.zeros(0, np.int64)  # active tracks in the reference's order: creation number (the online id)
+        self.last, self.max_score, self.length = np.zeros((0, 4)), np.zeros(0), np.zeros(0, np.int64)
+        self.next_key = 1
+        self.history: list[tuple[np.ndarray, np.ndarray]] = []  # per frame: the active tracks' keys and boxes
+        self.finished: list[int] = []  # keys of kept tracks, in the order the reference finishes them
+
+    def _kept(self, rows) -> np.ndarray:
+        return (self.max_score[rows] >= self.params["sigma_h"]) & (self.length[rows] >= self.params["t_min"])
 
     def update(self, obs) -> Tracks:
-        p, book = self.params, self.book
+        p = self.params
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["sigma_l"]]
-        iou = iou_matrix(book.boxes, dets[:, :4])
+        iou = corner_iou(_corners(self.last), _corners(dets))
         free = np.ones(len(dets), bool)
-        match = np.full(len(book), -1)
-        for r in range(len(book)):  # greedy, in track order, as the paper's algorithm
+        match = np.full(len(self.key), -1)
+        for r in range(len(self.key)):  # greedy, in track order: each track takes the best detection still free
             if free.any():
-                j = int(np.argmax(np.where(free, iou[r], -1.0)))
+                j = int(np.argmax(np.where(free, iou[r], -np.inf)))
                 if iou[r, j] >= p["sigma_iou"]:
                     match[r], free[j] = j, False
-        rows = np.flatnonzero(match >= 0)
-        book.predict()
-        book.hit(rows, dets[match[rows], :4], np.maximum(book.score[rows], dets[match[rows], 4]))
-        book.keep(book.misses == 0)
-        book.add(dets[free, :4], dets[free, 4])
-        report = (book.hits >= p["t_min"]) & (book.score >= p["sigma_h"])
-        return Tracks.of(book.ids[report], book.boxes[report], book.score[report])
+        ended = np.flatnonzero(match < 0)
+        self.finished += self.key[ended[self._kept(ended)]].tolist()
+        on = match >= 0
+        new = np.flatnonzero(free)
+        self.key = np.r_[self.key[on], np.arange(self.next_key, self.next_key + len(new))]
+        self.next_key += len(new)
+        self.last = np.r_[dets[match[on], :4], dets[new, :4]]
+        self.max_score = np.r_[np.maximum(self.max_score[on], dets[match[on], 4]), dets[new, 4]]
+        self.length = np.r_[self.length[on] + 1, np.ones(len(new), np.int64)]
+        self.history.append((self.key, self.last))
+        report = self._kept(slice(None))
+        return Tracks.of(self.key[report], self.last[report], self.max_score[report])
+
+    def results(self, online: list[Tracks]) -> list[Tracks]:
+        """The published offline output: every frame of each kept track, ids 1, 2, ... in finishing order (tracks
+        still active at the end finish last)."""
+        finished = self.finished + self.key[self._kept(slice(None))].tolist()
+        number = {k: i + 1 for i, k in enumerate(finished)}
+        out = []
+        for keys, boxes in self.history:
+            keep = np.isin(keys, finished)
+            out.append(Tracks.of([number[k] for k in keys[keep].tolist()], boxes[keep]))
+        return out

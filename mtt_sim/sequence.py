@@ -1,0 +1,235 @@
+"""A recorded MOTChallenge sequence as the env's source of ground truth, detections and frames.
+
+A sequence folder (MOT15/16/17/20 layout) holds `seqinfo.ini`, `det/det.txt`, and optionally `gt/gt.txt` and the
+frames in `img1/`. Detections are given to trackers exactly as written (raw confidences too); frames are read one at
+a time when asked for. Ground truth is scored as TrackEval's MotChallenge2DBox scores the benchmark:
+- MOT16/17/20: tracker boxes matched (Hungarian, IoU >= 0.5) to a ground-truth box of a distractor class
+  (person on vehicle, static person, distractor, reflection; MOT20 also non-MOT vehicle) are removed, then only
+  pedestrians (class 1) whose `considered` column is not 0 are scored;
+- MOT15: no classes; rows whose `considered` column is 0 are not scored.
+The visibility column (MOT16/17/20) is read into the truth the env shows, and not used for scoring, as in TrackEval.
+"""
+
+from __future__ import annotations
+
+import configparser
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import cv2
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from . import scenario as scn
+from .scenario import is_sequence
+from .metrics import EPS, box_iou
+from .truth import Truth
+
+BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20")
+PEDESTRIAN = 1
+DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
+VALID_CLASSES = range(1, 14)
+FRAME_RATE = 30.0  # where seqinfo.ini gives none
+
+
+@dataclass(frozen=True)
+class SequenceInfo:
+    """What seqinfo.ini says of a sequence (or, without one, what its frames and data imply)."""
+
+    name: str
+    width: int
+    height: int
+    frame_rate: float
+    length: int
+    image_dir: str = "img1"
+    image_ext: str = ".jpg"
+
+
+class Recording:
+    """One sequence's detections, ground truth and frames, frame by frame (frame k = file frame k + 1)."""
+
+    def __init__(self, folder, benchmark: str | None = None):
+        self.folder = Path(folder)
+        if not is_sequence(self.folder):
+            raise scn.ConfigError(f"{folder}: not a MOTChallenge sequence folder (expected seqinfo.ini, det/det.txt or "
+                                  "gt/gt.txt in it)")
+        det_file, gt_file = self.folder / "det" / "det.txt", self.folder / "gt" / "gt.txt"
+        det = read_rows(det_file, 7) if det_file.is_file() else np.zeros((0, 7))
+        gt = read_rows(gt_file, 7) if gt_file.is_file() else None
+        self.info = _read_info(self.folder, [det, gt if gt is not None else np.zeros((0, 7))])
+        for path, rows in ((det_file, det), (gt_file, gt)):
+            check_frames(path, rows, self.info.length)
+        self.scored = gt is not None
+        self.benchmark = benchmark or _benchmark_of(self.info.name, gt)
+        if self.benchmark not in BENCHMARKS:
+            raise scn.ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
+        self._det = by_frame(det, self.info.length)
+        gt = gt if gt is not None else np.zeros((0, 9))
+        columns = gt.shape[1]
+        self._classes_used = self.benchmark != "MOT15"
+        if self._classes_used and len(gt):
+            bad = ~np.isin(gt[:, 7] if columns > 7 else np.ones(len(gt)), VALID_CLASSES)
+            if bad.any():
+                raise ValueError(f"{gt_file}: row {int(np.flatnonzero(bad)[0]) + 1} has class {gt[bad][0, 7]:g}, not one "
+                                 f"of {self.benchmark}'s classes 1..13 (pass benchmark='MOT15' to score without classes)")
+        extra = np.c_[gt[:, 7] if columns > 7 else np.ones(len(gt)), gt[:, 8] if columns > 8 and self._classes_used
+                      else np.ones(len(gt))] if len(gt) else np.zeros((0, 2))
+        self._gt = by_frame(np.c_[gt[:, :7], extra] if len(gt) else np.zeros((0, 9)), self.info.length)
+        self.has_images = (self.folder / self.info.image_dir).is_dir()
+        counts = np.diff(self._det[1])
+        self.max_detections = int(counts.max()) if len(counts) else 0
+        self.det_range = (det[:, 2:7].min(axis=0), det[:, 2:7].max(axis=0)) if len(det) else (np.zeros(5), np.zeros(5))
+
+    def __len__(self) -> int:
+        return self.info.length
+
+    def detections(self, k: int) -> np.ndarray:
+        """(n, 5) x, y, w, h, confidence of frame k, as written (none past the last frame)."""
+        return _frame_rows(self._det, k)[:, 2:7]
+
+    def _gt_rows(self, k: int) -> np.ndarray:
+        return _frame_rows(self._gt, k)
+
+    def truth(self, k: int) -> Truth:
+        """Every ground-truth row of frame k (scored or not) as the env's Truth; visibility from the file (MOT16/17/20)."""
+        g = self._gt_rows(k)
+        boxes, n = g[:, 2:6], len(g)
+        return Truth(ids=g[:, 1].astype(np.int64), boxes=boxes, visibility=g[:, 8], visible_boxes=boxes,
+                     depth=np.zeros(n), labels=np.zeros(n, int), pieces=np.zeros((0, 5)))
+
+    def scoring(self, k: int, track_boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(scored GT ids, scored GT boxes, mask of the tracks that are scored) of frame k, by TrackEval's rules."""
+        g = self._gt_rows(k)
+        keep_tracks = np.ones(len(track_boxes), bool)
+        if self._classes_used and len(g) and len(track_boxes):
+            similarity = box_iou(g[:, 2:6], track_boxes)
+            similarity[similarity < 0.5 - EPS] = 0
+            rows, cols = linear_sum_assignment(-similarity)
+            matched = similarity[rows, cols] > EPS
+            distractor = np.isin(g[rows[matched], 7], DISTRACTORS[self.benchmark])
+            keep_tracks[cols[matched][distractor]] = False
+        scored = g[:, 6] != 0
+        if self._classes_used:
+            scored &= g[:, 7] == PEDESTRIAN
+        return g[scored, 1].astype(np.int64), g[scored, 2:6], keep_tracks
+
+    def image(self, k: int) -> np.ndarray:
+        """Frame k's image, RGB uint8 (H, W, 3), read from its file now."""
+        path = self.folder / self.info.image_dir / f"{k + 1:06d}{self.info.image_ext}"
+        img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        if img is None:
+            raise FileNotFoundError(f"{path}: frame {k + 1} of the sequence cannot be read")
+        if img.shape[:2] != (self.info.height, self.info.width):
+            raise ValueError(f"{path}: {img.shape[1]}x{img.shape[0]} pixels, but the sequence is "
+                             f"{self.info.width}x{self.info.height} (seqinfo.ini)")
+        return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
+
+    def scenario(self, overrides: Mapping | None = None) -> scn.Scenario:
+        """The configuration the env runs this sequence with: image size, length and detection rows from the data;
+        only `env.*` and `scoring.*` keys can be overridden."""
+        overrides = scn.expand_dotted(overrides or {})
+        other = sorted(set(overrides) - {"env", "scoring"})
+        if other:
+            raise scn.ConfigError(f"{self.folder}: a recorded sequence takes only env.* and scoring.* overrides, not "
+                                  f"{other[0]}.*")
+        obs_mode = overrides.get("env", {}).get("obs_mode")
+        if obs_mode == "frame+detections" and not self.has_images:
+            raise scn.ConfigError(f"{self.folder}: env.obs_mode = 'frame+detections', but the sequence has no "
+                                  f"{self.info.image_dir}/ folder of frames; use obs_mode='detections'")
+        i = self.info
+        raw = {"name": "Replay", "description": f"the recorded sequence {i.name} ({self.folder})",
+               "render": {"width": i.width, "height": i.height, "background": "flat"},
+               "sensor": {"max_detections": max(1, self.max_detections)},
+               "env": {"max_steps": i.length, "obs_mode": "frame+detections" if self.has_images else "detections"}}
+        return scn.from_mapping(scn.merge(raw, overrides), str(self.folder))
+
+
+def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
+    """seqinfo.ini's fields; where missing, the image files', then the data's (frame rate: 30)."""
+    ini = configparser.ConfigParser()
+    ini.optionxform = str
+    section = ini["Sequence"] if ini.read(folder / "seqinfo.ini") and "Sequence" in ini else {}
+    image_dir, image_ext = section.get("imDir", "img1"), section.get("imExt", ".jpg")
+    images = sorted((folder / image_dir).glob(f"*{image_ext}")) if (folder / image_dir).is_dir() else []
+    rows = np.concatenate([d[:, :6] for d in data])
+
+    def number(key, kind, fallback):
+        text = section.get(key)
+        if text is None:
+            return fallback()
+        try:
+            value = kind(text)
+        except ValueError:
+            value = 0
+        if value <= 0:
+            raise scn.ConfigError(f"{folder / 'seqinfo.ini'}: {key} = {text!r}: expected a positive number")
+        return value
+
+    def image_size():
+        if images:
+            img = cv2.imread(str(images[0]), cv2.IMREAD_UNCHANGED)
+            if img is not None:
+                return img.shape[1], img.shape[0]
+        corner = (rows[:, 2:4] + rows[:, 4:6]).max(axis=0) if len(rows) else np.ones(2)
+        return int(np.ceil(max(corner[0], 16))), int(np.ceil(max(corner[1], 16)))
+
+    width = number("imWidth", int, lambda: image_size()[0])
+    height = number("imHeight", int, lambda: image_size()[1])
+    length = number("seqLength", int, lambda: len(images) or int(rows[:, 0].max(initial=1)))
+    return SequenceInfo(section.get("name", folder.name), width, height,
+                        float(number("frameRate", float, lambda: FRAME_RATE)), length, image_dir, image_ext)
+
+
+def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
+    """A MOTChallenge text file as a float array (rows, columns), with a clear error for a malformed one."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: not found")
+    text = path.read_text().strip()
+    if not text:
+        return np.zeros((0, min_columns))
+    try:
+        rows = np.array([[float(v) for v in line.replace(" ", "").split(",")] for line in text.splitlines()])
+    except ValueError as err:
+        raise ValueError(f"{path}: not a comma-separated MOTChallenge file ({err})") from None
+    if rows.ndim != 2 or rows.shape[1] < min_columns:
+        raise ValueError(f"{path}: every row needs at least {min_columns} comma-separated values "
+                         "(frame, id, x, y, w, h, ...)")
+    if not np.isfinite(rows[:, :6]).all():
+        raise ValueError(f"{path}: row {int(np.flatnonzero(~np.isfinite(rows[:, :6]).all(1))[0]) + 1} is not finite")
+    return rows
+
+
+def check_frames(path: Path, rows: np.ndarray | None, length: int) -> None:
+    """Frame numbers must lie in 1..length; a seqLength shorter than the data is an error, not a silent cut."""
+    if rows is None or not len(rows):
+        return
+    frames = rows[:, 0]
+    bad = (frames < 1) | (frames > length) | (frames != np.round(frames))
+    if bad.any():
+        raise ValueError(f"{path}: row {int(np.flatnonzero(bad)[0]) + 1} has frame {frames[bad][0]:g}, outside the "
+                         f"sequence's 1..{length} (seqLength)")
+
+
+def by_frame(rows: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows sorted by frame (stable: file order within a frame) and where each frame's rows start (length + 1)."""
+    order = np.argsort(rows[:, 0], kind="stable")
+    rows = rows[order]
+    return rows, np.searchsorted(rows[:, 0], np.arange(1, length + 2), side="left")
+
+
+def _frame_rows(indexed: tuple[np.ndarray, np.ndarray], k: int) -> np.ndarray:
+    """Frame k's rows of a `by_frame` table; none past the last frame."""
+    rows, bounds = indexed
+    return rows[bounds[k]: bounds[k + 1]] if k + 1 < len(bounds) else rows[:0]
+
+
+def _benchmark_of(name: str, gt: np.ndarray | None) -> str:
+    """MOT16/17/20 by the name's prefix; otherwise MOT17 where the ground truth has classes, else MOT15."""
+    for bench in ("MOT16", "MOT17", "MOT20"):
+        if name.upper().startswith(bench + "-"):
+            return bench
+    if gt is not None and gt.shape[1] >= 8 and len(gt) and np.isin(gt[:, 7], VALID_CLASSES).all():
+        return "MOT17"
+    return "MOT15"
