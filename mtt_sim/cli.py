@@ -210,20 +210,23 @@ def cmd_run(args) -> int:
     overrides = parse_overrides(args.config)
     _loaded([args.scenario], overrides)
     video = _output(args.video, args.force, "--video", (".mp4", ".avi"))
+    results = _output(args.results, args.force, "--results", (".txt",))
     from . import experiment
 
-    record = experiment.run_episode(args.scenario, args.tracker, args.seed, overrides, video=args.video,
-                                    steps=args.steps, progress=True)
+    record = experiment.run_episode(args.scenario, args.tracker, args.seed, overrides, results=args.results,
+                                    video=args.video, steps=args.steps, progress=True)
+    metrics = record["metrics"] or {"metrics": "none: the sequence has no gt/gt.txt"}
     summary = {"scenario": args.scenario, "tracker": args.tracker, "seed": args.seed,
-               **{k: record["metrics"][k] for k in SUMMARY_KEYS},
+               **{k: metrics[k] for k in SUMMARY_KEYS if k in metrics}, **({} if record["metrics"] else metrics),
                "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
     if args.json:
         print(json.dumps(summary))
         return 0
     for k, v in summary.items():
         print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
-    if video:
-        print(f"{'video':12s} {video}" + (" (replaced)" if args.force else ""))
+    for name, path in (("video", video), ("results", results)):
+        if path:
+            print(f"{name:12s} {path}" + (" (replaced)" if args.force else ""))
     return 0
 
 
@@ -271,10 +274,14 @@ def _table(records, metric, by, title) -> str:
 
 def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
     """Run a bench or sweep grid: records written as they finish, a table(records, metric) per metric and the failed
-    episodes at the end,
-    and on Ctrl-C or SIGTERM the workers stopped and what finished kept. Exit status: 0, 1 if an episode failed,
-    130 if interrupted."""
+    episodes at the end, and on Ctrl-C or SIGTERM the workers stopped and what finished kept. Exit status: 0, 1 if an
+    episode failed, 130 if interrupted."""
     out = _output(args.out, args.force, "--out", (".csv", ".json"))
+    if args.results_dir:
+        folder = Path(args.results_dir)
+        if folder.exists() and (not folder.is_dir() or any(folder.iterdir())) and not args.force:
+            raise UsageError("--results-dir", f"{args.results_dir!r} exists and is not empty; add --force to write into it")
+        _writable_folder(folder if folder.is_dir() else folder.parent, "--results-dir", args.results_dir)
     if args.backend == "ray":
         _require("ray", "--backend", "ray")
     from . import experiment
@@ -291,7 +298,7 @@ def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
     try:
         records = experiment.run_grid(args.trackers, scenarios, args.seeds, config=overrides, configs=configs,
                                       workers=args.workers, progress=True, backend=args.backend, address=args.address,
-                                      on_record=keep)
+                                      on_record=keep, results_dir=args.results_dir)
     except KeyboardInterrupt:
         records, interrupted = finished, True
     finally:
@@ -311,6 +318,8 @@ def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
                   f"    again: {shlex.join(again + (['--config', *config] if config else []))}")
     if out:
         print(f"\nrecords: {out}" + (" (replaced)" if args.force else ""))
+    if args.results_dir:
+        print(f"results files: {args.results_dir}/<tracker>/<scenario>[-seed<k>].txt")
     if interrupted:
         print(f"mtt-sim {args.command}: interrupted; {len(done)} of {_grid_size(args, scenarios, configs)} episodes "
               "finished" + (f", their records in {out}" if out else ""), file=sys.stderr)
@@ -390,15 +399,16 @@ def cmd_export(args) -> int:
 
 
 def cmd_eval(args) -> int:
-    for argument, path, kind in (("--gt", Path(args.gt) / "seqinfo.ini", "a sequence folder with seqinfo.ini"),
+    for argument, path, kind in (("--gt", Path(args.gt) / "gt" / "gt.txt", "a sequence folder with gt/gt.txt"),
                                  ("--results", Path(args.results), "a results file")):
         if not path.is_file():
             raise UsageError(argument, f"{str(path)!r} not found; expected {kind}")
     from . import motchallenge
 
     s = scenario.ScoringConfig()
-    metrics = motchallenge.evaluate_results(args.gt, args.results, similarity=args.similarity, threshold=args.threshold,
-                                            zero_distance=s.zero_distance, gospa_c=s.gospa_c, gospa_p=s.gospa_p)
+    metrics = motchallenge.evaluate_results(args.gt, args.results, benchmark=args.benchmark, similarity=args.similarity,
+                                            threshold=args.threshold, zero_distance=s.zero_distance,
+                                            gospa_c=s.gospa_c, gospa_p=s.gospa_p)
     summary = {k: metrics[k] for k in SUMMARY_KEYS}
     if args.json:
         print(json.dumps(summary))
@@ -406,6 +416,14 @@ def cmd_eval(args) -> int:
     for k, v in summary.items():
         print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
     return 0
+
+
+def cmd_check_real(args) -> int:
+    if not (Path(args.data) / "mot15").is_dir():
+        raise UsageError("data", f"{args.data!r}: expected the shared data folder (with mot15/, reference/, mot17/)")
+    from . import check_real
+
+    return 0 if check_real.check(args.data) else 1
 
 
 def cmd_config(args) -> int:
@@ -427,7 +445,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("list", help="scenarios with their env ids and one-line descriptions").set_defaults(func=cmd_list)
     sub.add_parser("trackers", help="trackers with their descriptions and parameters (default, allowed values)"
                    ).set_defaults(func=cmd_trackers)
-    scenario_help = "scenario key (see `mtt-sim list`, any case), env id (mtt_sim/Crossing-v0) or .toml file"
+    scenario_help = ("scenario key (see `mtt-sim list`, any case), env id (mtt_sim/Crossing-v0), .toml file or a "
+                     "MOTChallenge sequence folder")
     config_help = "overrides, e.g. sensor.clutter_rate=5 groups.0.count=10"
     force_help = "replace an existing output"
 
@@ -439,6 +458,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--steps", type=_integer(1), default=None, help="at most this many steps (default: the "
                                                                         "scenario's env.max_steps)")
     run.add_argument("--video", help="write an annotated video (.mp4 or .avi)")
+    run.add_argument("--results", help="write the tracks as a MOTChallenge results file (.txt; an offline method's "
+                                       "offline output)")
     run.add_argument("--force", action="store_true", help=force_help)
     run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -471,6 +492,7 @@ def build_parser() -> argparse.ArgumentParser:
         g.add_argument("--metric", type=_metrics, default=["MOTA"],
                        help="metric(s) of the tables, comma-separated, any case (default MOTA)")
         g.add_argument("--out", help="write every episode's record as it finishes (.csv or .json)")
+        g.add_argument("--results-dir", help="write every episode's tracks as a MOTChallenge results file in this folder")
         g.add_argument("--force", action="store_true", help=force_help)
         g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")
         g.set_defaults(func=func)
@@ -502,13 +524,21 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
     ex.set_defaults(func=cmd_export)
 
-    ev = sub.add_parser("eval", help="score a MOTChallenge results file against an exported sequence")
-    ev.add_argument("--gt", required=True, help="the sequence folder (with seqinfo.ini and gt/gt.txt)")
+    ev = sub.add_parser("eval", help="score a MOTChallenge results file against a sequence's ground truth, as TrackEval")
+    ev.add_argument("--gt", required=True, help="the sequence folder (gt/gt.txt; seqinfo.ini if it has one)")
+    ev.add_argument("--benchmark", choices=("MOT15", "MOT16", "MOT17", "MOT20"),
+                    help="the scoring rules (default: from the folder's name, else MOT17 where gt.txt has classes, "
+                         "else MOT15)")
     ev.add_argument("--results", required=True, help="frame, id, x, y, w, h, ... per line")
     ev.add_argument("--similarity", choices=("iou", "centroid"), default="iou")
     ev.add_argument("--threshold", type=_fraction, default=0.5, help="match threshold in (0, 1] (default 0.5)")
     ev.add_argument("--json", action="store_true")
     ev.set_defaults(func=cmd_eval)
+
+    cr = sub.add_parser("check-real", help="hold sort, bytetrack and the scoring against real MOTChallenge data and "
+                                           "the reference codes' outputs")
+    cr.add_argument("data", help="the shared data folder (mot15/, reference/, mot17/, mot17_results/)")
+    cr.set_defaults(func=cmd_check_real)
 
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
     cf.add_argument("scenario", nargs="?", type=_scenario, help=scenario_help)

@@ -13,6 +13,7 @@ import csv
 import itertools
 import json
 import math
+import re
 import time
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
@@ -26,22 +27,27 @@ import trackers
 from . import pool
 from .env import TrackingEnv
 from .metrics import METRICS, PER_TARGET
+from .motchallenge import write_results
 from .overlay import VideoWriter, draw_debug
 
 BACKENDS = ("local", "ray")
 
 
 def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Mapping | None = None,
-                video: str | None = None, steps: int | None = None, progress: bool = False) -> dict:
-    """One episode of `tracker` on `scenario`; optionally an annotated video and a progress bar (shown once the
-    episode has run for a second). Returns a record."""
+                results: str | None = None, video: str | None = None, steps: int | None = None,
+                progress: bool = False) -> dict:
+    """One episode of `tracker` on `scenario` (a shipped key, a .toml file or a recorded sequence's folder); optionally
+    a MOTChallenge results file of its tracks (`tracker.results`: the offline output of an offline method), an
+    annotated video and a progress bar (shown once the episode has run for a second). Returns a record; its
+    metrics are None on a recorded sequence without ground truth."""
     agent = trackers.make(tracker)
-    obs_mode = "frame+detections" if agent.needs_frame or video else "detections"
-    env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if video else None, obs_mode=obs_mode)
+    env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if video else None,
+                      obs_mode="frame+detections" if agent.needs_frame else "detections")
     obs, info = env.reset(seed=seed)
     agent.reset(info)
     writer = VideoWriter(video, (env.scenario.render.width, env.scenario.render.height)) if video else None
     tracker_time = env_time = 0.0
+    online: list[trackers.Tracks] = []
     limit = steps or env.scenario.env.max_steps
     steps_ = tqdm(range(limit), desc=f"{tracker} on {scenario}", unit="frame", delay=1.0, leave=False) if progress \
         else range(limit)
@@ -50,6 +56,8 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
         tracks = agent.update(obs)
         mid = time.perf_counter()
         action = tracks.to_action(env.action_space)
+        n = action["num_tracks"]
+        online.append(trackers.Tracks.of(action["ids"][:n], action["boxes"][:n]))
         if writer:
             env.remember_tracks(tracks.ids, tracks.boxes)
             writer.write(draw_debug(env.render(), agent.debug()))
@@ -59,16 +67,19 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
             break
     if writer:
         writer.close()
-    metrics = env.metrics.summary()
-    frames = metrics["num_frames"]
+    if results:
+        write_results(results, [(t.ids, t.boxes) for t in agent.results(online)])
+    scored = env.recording is None or env.recording.scored
+    frames = len(online)
     return {"tracker": tracker, "params": agent.params, "scenario": str(scenario), "seed": seed,
-            "config": dict(config or {}), "error": None, "metrics": metrics, "per_target": env.metrics.per_target(),
+            "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
+            "per_target": env.metrics.per_target() if scored else {},
             "tracker_fps": frames / max(tracker_time, 1e-9), "env_fps": frames / max(env_time, 1e-9)}
 
 
 def failed_record(task: tuple, message: str) -> dict:
-    """The record of grid task (scenario, tracker, seed, config) whose episode failed with `message`."""
-    scenario, tracker, seed, config = task
+    """The record of grid task (scenario, tracker, seed, config, results file) whose episode failed with `message`."""
+    scenario, tracker, seed, config, _ = task
     return {"tracker": tracker, "params": {}, "scenario": str(scenario), "seed": seed, "config": dict(config),
             "error": message, "metrics": None, "per_target": {}, "tracker_fps": math.nan, "env_fps": math.nan}
 
@@ -84,18 +95,20 @@ def _task(task: tuple) -> dict:
 def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequence[int] | int,
              config: Mapping | None = None, configs: Sequence[Mapping] | None = None, workers: int = 1,
              progress: bool = False, backend: str = "local", address: str | None = None,
-             on_record: Callable[[dict], None] | None = None) -> list[dict]:
+             on_record: Callable[[dict], None] | None = None, results_dir: str | Path | None = None) -> list[dict]:
     """Every tracker x scenario x seed (x config, for sweeps); records in grid order. backend="local" runs them in
     `workers` processes; "ray" as Ray tasks, on a local Ray instance of `workers` CPUs or on the cluster at
     `address` (the [ray] extra). `on_record` is called with each record as it finishes, so an interrupted grid
-    keeps what it finished (KeyboardInterrupt stops the workers and propagates)."""
+    keeps what it finished (KeyboardInterrupt stops the workers and propagates). With `results_dir`, every episode
+    writes its tracks as a MOTChallenge results file, `results_dir/<tracker>/<scenario>[-seed<k>][-<config>].txt`."""
     if backend not in BACKENDS:
         raise ValueError(f"backend={backend!r}: allowed values: {', '.join(map(repr, BACKENDS))}")
     seeds = range(seeds) if isinstance(seeds, int) else seeds
     for spec in tracker_specs:
         trackers.make(spec)  # fail fast on a bad spec, before any process starts
-    tasks = [(sc, spec, seed, {**(config or {}), **c}) for c, sc, spec, seed in
-             itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
+    tasks = [(sc, spec, seed, {**(config or {}), **c},
+              results_path(results_dir, spec, sc, seed if len(seeds) > 1 else None, c) if results_dir else None)
+             for c, sc, spec, seed in itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
     records: list = [None] * len(tasks)
     with tqdm(total=len(tasks), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
         for i, record in _finished(tasks, workers, backend, address):
@@ -106,6 +119,17 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
                                 + (" failed" if record["error"] else ""), refresh=False)
             bar.update()
     return records
+
+
+def results_path(folder: str | Path, tracker: str, scenario: str, seed: int | None, config: Mapping) -> Path:
+    """Where a grid episode's results file goes: <folder>/<tracker>/<scenario name>[-seed<k>][-<key>=<value>...].txt
+    (a recorded sequence's name is its folder's, as TrackEval expects)."""
+    name = Path(scenario).stem if str(scenario).endswith(".toml") else Path(scenario).name
+    parts = [name] + ([f"seed{seed}"] if seed is not None else []) + [f"{k}={v}" for k, v in config.items()]
+    safe = lambda text: re.sub(r"[^A-Za-z0-9_.,=+-]", "_", str(text))  # noqa: E731
+    path = Path(folder) / safe(tracker) / (safe("-".join(parts)) + ".txt")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
 
 
 def _finished(tasks: list, workers: int, backend: str, address: str | None) -> Iterator[tuple[int, dict]]:
@@ -169,6 +193,8 @@ def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario
     cells: dict[tuple, list[tuple[float, dict]]] = {}
     for r in records:
         column = r["scenario"] if by == "scenario" else json.dumps(r["config"], sort_keys=True)
+        if r.get("metrics") is None and not r.get("error"):  # an unscored recorded sequence: nothing to average
+            continue
         if r.get("error"):  # a failed cell; per target there is no column to put it in (the failures are listed apart)
             if by != "target":
                 cells.setdefault((r["tracker"], column), []).append((math.nan, r))
