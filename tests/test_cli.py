@@ -106,7 +106,7 @@ BAD_ARGUMENTS = [
     (["learn-reid", "--out", "metric.txt"], r"argument --out: 'metric.txt': the file name must end in \.npz"),
     (["perf", "--repeats", "0"], r"argument --repeats: must be an integer >= 1"),
     (["export", "crossing", "--out", "seq", "--steps", "0"], r"argument --steps: must be an integer >= 1"),
-    (["eval", "--gt", "nowhere", "--results", "r.txt"], r"argument --gt: 'nowhere/seqinfo.ini' not found"),
+    (["eval", "--gt", "nowhere", "--results", "r.txt"], r"argument --gt: 'nowhere/gt/gt.txt' not found"),
     (["eval", "--gt", "nowhere", "--results", "r.txt", "--threshold", "1.5"], r"--threshold: must be a number in \(0, 1\]"),
     (["config", "crossing", "--config", "sensor"], r"argument --config: 'sensor': expected key=value"),
 ]
