@@ -112,14 +112,14 @@ class TrackingEnv(gym.Env):
     @staticmethod
     def _spaces(sc: scn.Scenario, recording: Recording | None = None):
         """Simulated detections lie in the image with confidences in [0, 1] (float32); recorded ones are given as
-        written (float64), so their bounds are the extremes of the sequence's det.txt (and 0, for padding rows)."""
+        written (float64), so their bounds are those widened to the extremes of the sequence's det.txt."""
         w, h = sc.render.width, sc.render.height
         nd, nt = sc.sensor.max_detections, sc.env.max_tracks
         dtype = np.float32 if recording is None else np.float64
-        if recording is None:
-            det_low, det_high = np.zeros(5), np.array([w, h, w, h, 1.0])
-        else:
-            det_low, det_high = np.minimum(np.floor(recording.det_range[0]), 0), np.maximum(np.ceil(recording.det_range[1]), 0)
+        det_low, det_high = np.zeros(5), np.array([w, h, w, h, 1.0])
+        if recording is not None:
+            det_low = np.minimum(det_low, np.floor(recording.det_range[0]))
+            det_high = np.maximum(det_high, np.ceil(recording.det_range[1]))
         obs = {"detections": spaces.Box(np.tile(det_low.astype(dtype), (nd, 1)), np.tile(det_high.astype(dtype), (nd, 1)),
                                         (nd, 5), dtype),
                "num_detections": spaces.Discrete(nd + 1)}

@@ -63,3 +63,30 @@ def fail_on_two(x):
     if x == 3:
         os.kill(os.getpid(), signal.SIGKILL)
     return 2 * x
+
+
+def write_sequence(folder, det=(), gt=None, length=None, size=(100, 80), images=False, seqinfo=True, name=None):
+    """A tiny MOTChallenge sequence folder: det rows (frame, x, y, w, h, score), gt rows (frame, id, x, y, w, h,
+    considered, class, visibility) or None for none, optional seqinfo.ini and img1/ frames (each a flat grey
+    level that encodes its frame number)."""
+    import cv2
+    from pathlib import Path
+
+    folder = Path(folder)
+    (folder / "det").mkdir(parents=True, exist_ok=True)
+    (folder / "det" / "det.txt").write_text("".join(f"{f},-1,{x!r},{y!r},{w!r},{h!r},{s!r},-1,-1,-1\n"
+                                                    for f, x, y, w, h, s in det))
+    if gt is not None:
+        (folder / "gt").mkdir(exist_ok=True)
+        (folder / "gt" / "gt.txt").write_text("".join(",".join(repr(v) if isinstance(v, float) else str(v)
+                                                                for v in row) + "\n" for row in gt))
+    frames = length or max([r[0] for r in det] + [r[0] for r in gt or []] + [1])
+    if seqinfo:
+        (folder / "seqinfo.ini").write_text(f"[Sequence]\nname={name or folder.name}\nimDir=img1\nframeRate=10\n"
+                                            f"seqLength={frames}\nimWidth={size[0]}\nimHeight={size[1]}\nimExt=.png\n")
+    if images:  # lossless PNG where seqinfo.ini can say so; JPEG, the default, where there is none
+        (folder / "img1").mkdir(exist_ok=True)
+        for f in range(1, frames + 1):
+            cv2.imwrite(str(folder / "img1" / f"{f:06d}{'.png' if seqinfo else '.jpg'}"),
+                        np.full((size[1], size[0], 3), 10 * f, np.uint8))
+    return folder

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 import mtt_sim  # noqa: F401
 import trackers
 from helpers import run_tracker
-from trackers.assignment import assign, iou_matrix, murty
+from trackers.assignment import assign, iou_matrix, lapjv, murty, plus_one_iou
 from trackers.kalman import KalmanBank, box_model, boxes_to_z, point_model, z_to_boxes
 
 BASELINES = ["sort", "iou", "gnn", "bytetrack"]
@@ -283,3 +283,76 @@ def test_murty_edge_cases():
         murty(np.zeros((3, 2)), 1)
     with pytest.raises(ValueError, match="NaN"):
         murty(np.array([[np.nan, 1.0]]), 1)
+
+
+def run_frames(spec, frames, **reset_info):
+    """Tracker `spec` over hand-made frames (lists of x, y, w, h, score rows): each frame's {id: box}."""
+    t = trackers.make(spec)
+    t.reset(reset_info or {"image_size": (200, 100)})
+    out = []
+    for rows in frames:
+        d = np.array(rows, float).reshape(-1, 5)
+        tr = t.update({"detections": d, "num_detections": len(d)})
+        out.append({int(i): b for i, b in zip(tr.ids, tr.boxes.tolist())})
+    return out, t
+
+
+def box(x0, x1, score=0.9):
+    return (x0, 0.0, x1 - x0, 20.0, score)
+
+
+def test_sort_reports_a_track_once_it_has_three_matches_after_its_first_detection():
+    frames = [[box(0, 10)] + ([box(50, 60)] if f >= 5 else []) for f in range(1, 11)]
+    out, _ = run_frames("sort", frames)
+    assert [sorted(o) for o in out] == [[1]] * 7 + [[1, 2]] * 3  # the second box, seen from frame 5, from frame 8
+
+
+def test_sort_undoes_low_iou_pairs_after_the_hungarian_and_numbers_new_tracks_as_the_reference():
+    """Frame 5: the Hungarian maximising total IoU pairs D1 with T2 (IoU 0.14, undone) and D2 with T1 (0.82), though
+    D1 overlaps T1 more (0.90): so T1 follows D2, and the new tracks are D3 (never paired) then D1 (undone)."""
+    t1, t2 = box(0, 10), box(8, 18)
+    d1, d2, d3 = box(0.5, 10.5), box(-1, 9), box(100, 110)
+    out, _ = run_frames("sort", [[t1, t2]] * 4 + [[d1, d2, d3]] * 4)
+    assert sorted(out[4]) == [1] and out[4][1][0] < 0  # frame 5: track 1 moved toward D2 (x = -1), track 2 unmatched
+    assert sorted(out[7]) == [1, 3, 4] and out[7][1][0] < -0.5  # frame 8: D3 became track 3, D1 track 4
+    assert (round(out[7][3][0], 3), round(out[7][4][0], 3)) == (100.0, 0.5)
+
+
+def test_bytetrack_activation_second_round_and_lost_tracks():
+    a, b = box(0, 10), box(50, 60)
+    frames = [[a], [a, b], [a, b], [(*a[:4], 0.3), b]] + [[b]] * 10 + [[a, b]]
+    out, _ = run_frames("bytetrack", frames)
+    assert sorted(out[0]) == [1]             # activated in the first frame
+    assert sorted(out[1]) == [1] and sorted(out[2]) == [1, 2]  # a new track is reported from its second match
+    assert sorted(out[3]) == [1, 2]          # a low-score detection (0.3) keeps track 1 in the second round
+    assert sorted(out[14]) == [1, 2]         # lost for 10 frames (< 30), track 1 is found again with its id
+    late = run_frames("bytetrack", [[a]] + [[]] * 32 + [[a], [a]])[0]
+    assert sorted(late[-1]) == [2]           # lost for 32 frames (> 30), it was removed: a new id
+    weak = run_frames("bytetrack", [[b], [(*a[:4], 0.55), b], [(*a[:4], 0.55), b]])[0]
+    assert sorted(weak[-1]) == [1]           # 0.55 < track_thresh + 0.1: never starts a track
+
+
+def test_iou_tracker_reports_online_from_when_a_track_qualifies_and_offline_from_its_start():
+    frames = [[box(0, 10, s)] for s in (0.3, 0.4, 0.7, 0.8)] + [[box(40, 50, 0.4)]] * 3
+    online, tracker = run_frames("iou:sigma_h=0.5,t_min=2", frames)
+    assert [sorted(o) for o in online] == [[], [], [1], [1], [], [], []]
+    offline = tracker.results([])
+    assert [t.ids.tolist() for t in offline] == [[1], [1], [1], [1], [], [], []]  # the second track never reaches 0.5
+
+
+def test_plus_one_iou_counts_pixels_inclusively():
+    a = np.array([[0.0, 0.0, 9.0, 9.0]])
+    np.testing.assert_allclose(plus_one_iou(a, np.array([[0.0, 0.0, 9.0, 9.0], [5.0, 0.0, 14.0, 9.0],
+                                                         [10.0, 0.0, 19.0, 9.0]])), [[1.0, 50 / 150, 0.0]])
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(1, 4), st.integers(1, 4), st.floats(0.1, 2.0), st.integers(0, 2**31))
+def test_lapjv_with_a_cost_limit_is_the_cheapest_partial_matching(n, m, limit, seed):
+    cost = np.random.default_rng(seed).uniform(0, 1.5, (n, m))
+    matches, free_rows, free_cols = lapjv(cost, limit)
+    total = cost[matches[:, 0], matches[:, 1]].sum() + limit / 2 * (len(free_rows) + len(free_cols))
+    best = min(sum(cost[r, c] for r, c in pairs) + limit / 2 * (n + m - 2 * len(pairs))
+               for k in range(min(n, m) + 1) for rows in permutations(range(n), k)
+               for cols in permutations(range(m), k) for pairs in [list(zip(rows, cols))])
+    assert total == pytest.approx(best, abs=1e-9)
