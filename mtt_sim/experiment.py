@@ -192,7 +192,7 @@ def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario
                          f"{', '.join(names)}")
     cells: dict[tuple, list[tuple[float, dict]]] = {}
     for r in records:
-        column = r["scenario"] if by == "scenario" else json.dumps(r["config"], sort_keys=True)
+        column = _label(r["scenario"]) if by == "scenario" else json.dumps(r["config"], sort_keys=True)
         if r.get("metrics") is None and not r.get("error"):  # an unscored recorded sequence: nothing to average
             continue
         if r.get("error"):  # a failed cell; per target there is no column to put it in (the failures are listed apart)
@@ -209,10 +209,16 @@ def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario
         values = np.array([v for v, _ in ran], float)
         mean, ci = mean_ci(values[np.isfinite(values)])
         rows.append({"tracker": tracker, "column": column, "metric": metric, "mean": mean, "ci95": ci, "n": len(ran),
-                     "failed": len(cell) - len(ran),
+                     "failed": len(cell) - len(ran), "integer": all(isinstance(v, int) for v, _ in ran),
                      "tracker_fps": float(np.median([r["tracker_fps"] for _, r in ran])) if ran else math.nan,
                      "env_fps": float(np.median([r["env_fps"] for _, r in ran])) if ran else math.nan})
     return rows
+
+
+def _label(scenario: str) -> str:
+    """A table's name for a scenario: its key, or the name of its .toml file or sequence folder."""
+    path = Path(scenario)
+    return path.stem if path.suffix == ".toml" else path.name
 
 
 def markdown(rows: Sequence[dict], title: str = "") -> str:
@@ -221,7 +227,8 @@ def markdown(rows: Sequence[dict], title: str = "") -> str:
     trackers_, columns = list(dict.fromkeys(r["tracker"] for r in rows)), list(dict.fromkeys(r["column"] for r in rows))
     cell = {(r["tracker"], r["column"]): r for r in rows}
     metric, n = rows[0]["metric"], max(r["n"] + r["failed"] for r in rows)
-    head = f"{metric} (mean ± 95% interval over {n} seeds)" + (f", {title}" if title else "")
+    head = (f"{metric} (mean ± 95% interval over {n} seeds)" if n > 1 else f"{metric} (one seed)") + \
+        (f", {title}" if title else "")
     lines = [head, "", "| tracker | " + " | ".join(columns) + " | tracker frames/s | env frames/s |",
              "|---|" + "---:|" * (len(columns) + 2)]
     for t in trackers_:
@@ -238,7 +245,9 @@ def _cell_text(row: dict | None) -> str:
     if not row["n"]:
         return "failed"
     failed = f" ({row['failed']} of {row['n'] + row['failed']} failed)" if row["failed"] else ""
-    return f"{row['mean']:.3f} ± {row['ci95']:.3f}{failed}"
+    digits = 0 if row["integer"] and row["n"] == 1 else 1 if row["integer"] else 3
+    value = f"{row['mean']:.{digits}f}" + (f" ± {row['ci95']:.{digits}f}" if row["n"] > 1 else "")
+    return value + failed
 
 
 def write_records(records: Sequence[dict], path: str | Path) -> None:

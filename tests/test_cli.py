@@ -135,7 +135,7 @@ def test_names_are_case_insensitive_and_env_ids_are_scenarios(capsys):
     assert cli.main(["bench", "--scenarios", "CROSSING", "--trackers", "Sort", "--seeds", "1", "--metric", "mota,Idf1",
                      "--config", "env.max_steps=3"]) == 0
     out = capsys.readouterr().out
-    assert "MOTA (mean" in out and "IDF1 (mean" in out and "| sort | " in out and "| crossing |" in out
+    assert "MOTA (one seed)" in out and "IDF1 (one seed)" in out and "| sort | " in out and "| crossing |" in out
 
 
 def test_tracker_specs_with_several_parameters_and_seed_forms(tmp_path, capsys):

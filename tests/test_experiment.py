@@ -108,6 +108,8 @@ def test_a_failing_episode_is_recorded_and_the_grid_goes_on(monkeypatch, tmp_pat
     assert records[1]["metrics"] is None and written == records  # handed over as they finished
     table = experiment.markdown(experiment.summarize(records, "MOTA"))
     assert "| fails_second | " in table and "(1 of 3 failed)" in table
+    assert "| sort | " in experiment.markdown(experiment.summarize(records[3:4], "IDSW"))  # one seed: "0", no interval
+    assert experiment.markdown(experiment.summarize(records[3:4], "IDSW")).splitlines()[-1].split(" | ")[1] == "0"
     all_failed = experiment.markdown(experiment.summarize(records[1:2], "MOTA"))
     assert "| fails_second | failed | - | - |" in all_failed
     experiment.write_records(records, tmp_path / "r.json")
