@@ -65,17 +65,7 @@ class Recording:
         if self.benchmark not in BENCHMARKS:
             raise scn.ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
         self._det = by_frame(det, self.info.length)
-        gt = gt if gt is not None else np.zeros((0, 9))
-        columns = gt.shape[1]
-        self._classes_used = self.benchmark != "MOT15"
-        if self._classes_used and len(gt):
-            bad = ~np.isin(gt[:, 7] if columns > 7 else np.ones(len(gt)), VALID_CLASSES)
-            if bad.any():
-                raise ValueError(f"{gt_file}: row {int(np.flatnonzero(bad)[0]) + 1} has class {gt[bad][0, 7]:g}, not one "
-                                 f"of {self.benchmark}'s classes 1..13 (pass benchmark='MOT15' to score without classes)")
-        extra = np.c_[gt[:, 7] if columns > 7 else np.ones(len(gt)), gt[:, 8] if columns > 8 and self._classes_used
-                      else np.ones(len(gt))] if len(gt) else np.zeros((0, 2))
-        self._gt = by_frame(np.c_[gt[:, :7], extra] if len(gt) else np.zeros((0, 9)), self.info.length)
+        self._gt = by_frame(_gt_table(gt, self.benchmark, gt_file), self.info.length)
         self.has_images = (self.folder / self.info.image_dir).is_dir()
         counts = np.diff(self._det[1])
         self.max_detections = int(counts.max()) if len(counts) else 0
@@ -102,16 +92,14 @@ class Recording:
         """(scored GT ids, scored GT boxes, mask of the tracks that are scored) of frame k, by TrackEval's rules."""
         g = self._gt_rows(k)
         keep_tracks = np.ones(len(track_boxes), bool)
-        if self._classes_used and len(g) and len(track_boxes):
+        if self.benchmark != "MOT15" and len(g) and len(track_boxes):
             similarity = box_iou(g[:, 2:6], track_boxes)
             similarity[similarity < 0.5 - EPS] = 0
             rows, cols = linear_sum_assignment(-similarity)
             matched = similarity[rows, cols] > EPS
             distractor = np.isin(g[rows[matched], 7], DISTRACTORS[self.benchmark])
             keep_tracks[cols[matched][distractor]] = False
-        scored = g[:, 6] != 0
-        if self._classes_used:
-            scored &= g[:, 7] == PEDESTRIAN
+        scored = (g[:, 6] != 0) & (g[:, 7] == PEDESTRIAN)  # MOT15's rows are all pedestrians (class 1)
         return g[scored, 1].astype(np.int64), g[scored, 2:6], keep_tracks
 
     def image(self, k: int) -> np.ndarray:
@@ -217,6 +205,21 @@ def by_frame(rows: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
     order = np.argsort(rows[:, 0], kind="stable")
     rows = rows[order]
     return rows, np.searchsorted(rows[:, 0], np.arange(1, length + 2), side="left")
+
+
+def _gt_table(gt: np.ndarray | None, benchmark: str, path: Path) -> np.ndarray:
+    """gt rows as frame, id, x, y, w, h, considered, class, visibility: class 1 and visibility 1 where the benchmark's
+    files have none (MOT15's later columns are world coordinates); classes are checked where they are used."""
+    if gt is None:
+        return np.zeros((0, 9))
+    n, columns = gt.shape
+    classes = gt[:, 7] if columns > 7 and benchmark != "MOT15" else np.ones(n)
+    visibility = gt[:, 8] if columns > 8 and benchmark != "MOT15" else np.ones(n)
+    bad = ~np.isin(classes, VALID_CLASSES)
+    if bad.any():
+        raise ValueError(f"{path}: row {int(np.flatnonzero(bad)[0]) + 1} has class {classes[bad][0]:g}, not one of "
+                         f"{benchmark}'s classes 1..13 (pass benchmark='MOT15' to score without classes)")
+    return np.c_[gt[:, :7], classes, visibility]
 
 
 def _frame_rows(indexed: tuple[np.ndarray, np.ndarray], k: int) -> np.ndarray:

@@ -57,15 +57,14 @@ class ByteTrack(Tracker):
 
         # first association: tracked and lost tracks with the high detections
         matches, left_tracks, left_high = self._associate(pool, tlwh[high], score[high], p["match_thresh"])
-        for t, d in matches:
+        for t, _ in matches:
             (activated if self.state[pool[t]] == TRACKED else refound).append(pool[t])
-            self._correct(pool[t], tlwh[high[d]], score[high[d]])
+        self._correct([pool[t] for t in matches[:, 0]], high[matches[:, 1]], tlwh, score)
         # second association: tracked tracks left with the low detections
         rest = [pool[t] for t in left_tracks if self.state[pool[t]] == TRACKED]
         matches, still, _ = self._associate(rest, tlwh[low], None, 0.5)
-        for t, d in matches:
-            activated.append(rest[t])
-            self._correct(rest[t], tlwh[low[d]], score[low[d]])
+        activated += [rest[t] for t in matches[:, 0]]
+        self._correct([rest[t] for t in matches[:, 0]], low[matches[:, 1]], tlwh, score)
         for t in still:
             if self.state[rest[t]] != LOST:
                 self.state[rest[t]] = LOST
@@ -73,9 +72,8 @@ class ByteTrack(Tracker):
         # tracks born last frame with the high detections left
         high = high[left_high]
         matches, left_new, left_high = self._associate(unconfirmed, tlwh[high], score[high], 0.7)
-        for t, d in matches:
-            activated.append(unconfirmed[t])
-            self._correct(unconfirmed[t], tlwh[high[d]], score[high[d]])
+        activated += [unconfirmed[t] for t in matches[:, 0]]
+        self._correct([unconfirmed[t] for t in matches[:, 0]], high[matches[:, 1]], tlwh, score)
         for t in left_new:
             self.state[unconfirmed[t]] = REMOVED
             removed_now.append(unconfirmed[t])
@@ -114,12 +112,16 @@ class ByteTrack(Tracker):
             cost = 1 - (1 - cost) * score[None, :]
         return lapjv(cost, limit)
 
-    def _correct(self, row: int, tlwh: np.ndarray, score: float) -> None:
-        """A match: the filter is corrected and the track is tracked and activated (re-found, if it was lost)."""
-        z = np.r_[tlwh[:2] + tlwh[2:] / 2, tlwh[2] / tlwh[3], tlwh[3]]
-        mean, cov = xyah_update(self.mean[row:row + 1], self.cov[row:row + 1], z[None])
-        self.mean[row], self.cov[row] = mean[0], cov[0]
-        self.state[row], self.activated[row], self.score[row], self.last_frame[row] = TRACKED, True, score, self.frame
+    def _correct(self, rows: list[int], dets: np.ndarray, tlwh: np.ndarray, score: np.ndarray) -> None:
+        """Matches of track `rows` with detections `dets`: filters corrected, tracks tracked and activated (re-found,
+        if they were lost)."""
+        if not rows:
+            return
+        box = tlwh[dets]
+        z = np.c_[box[:, :2] + box[:, 2:] / 2, box[:, 2] / box[:, 3], box[:, 3]]
+        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], z)
+        self.state[rows], self.activated[rows], self.score[rows], self.last_frame[rows] = TRACKED, True, score[dets], \
+            self.frame
 
     def _start(self, tlwh: np.ndarray, score: np.ndarray) -> list[int]:
         """New tracks (rows appended), activated at once only in the first frame."""
