@@ -337,6 +337,8 @@ def cmd_list(args) -> int:
     ids = env_ids()
     for key, desc in scenario.available().items():
         print(f"{key:14s} {ids[key]:26s} {desc}")
+    print(f"{'<folder>':14s} {'mtt_sim/Replay-v0':26s} a recorded MOTChallenge sequence (gym.make(..., sequence=folder); "
+          "any command takes its folder)")
     return 0
 
 
