@@ -87,7 +87,8 @@ def test_without_ground_truth_the_env_runs_unscored_and_says_so(tmp_path):
         _, reward, term, trunc, info = env.step({"ids": [1], "boxes": [A]})
         rewards.append(reward)
     assert rewards == [0.0, 0.0] and term and "metrics" not in info
-    assert experiment.run_episode(str(folder), "sort")["metrics"] is None
+    with pytest.warns(UserWarning, match="runs unscored"):
+        assert experiment.run_episode(str(folder), "sort")["metrics"] is None
 
 
 def test_a_short_seq_length_is_an_error_not_a_cut(tmp_path):
