@@ -11,8 +11,9 @@ from hypothesis import strategies as st
 import mtt_sim  # noqa: F401
 import trackers
 from helpers import run_tracker
-from trackers.assignment import assign, iou_matrix, lapjv, murty, plus_one_iou
-from trackers.kalman import KalmanBank, box_model, boxes_to_z, point_model, z_to_boxes
+from trackers.assignment import assign, corner_iou, lapjv, murty, plus_one_iou
+from trackers.kalman import KalmanBank, box_model, point_model
+from trackers.sort import corners_to_measurement, state_to_corners
 
 BASELINES = ["sort", "iou", "gnn", "bytetrack"]
 FRAMES = 30
@@ -231,8 +232,9 @@ def test_kalman_bank_matches_a_scalar_filter():
 
 
 def test_box_conversions_round_trip_and_sort_model_shapes():
-    boxes = np.array([[10, 20, 30, 60], [0, 0, 4, 2.0]])
-    np.testing.assert_allclose(z_to_boxes(boxes_to_z(boxes)), boxes)
+    corners = np.array([[10, 20, 40, 80], [0, 0, 4, 2.0]])
+    np.testing.assert_allclose(state_to_corners(corners_to_measurement(corners)), corners)
+    assert np.isnan(state_to_corners(np.array([[5.0, 5.0, -4.0, 1.0]]))).all()  # s * r < 0: the reference drops it
     assert box_model().F.shape == (7, 7)
 
 
@@ -242,7 +244,8 @@ def test_gated_assignment():
     assert sorted(map(tuple, matches.tolist())) == [(0, 0), (2, 1)] and rows.tolist() == [1] and cols.tolist() == []
     matches, rows, cols = assign(np.zeros((0, 3)), 1.0)
     assert len(matches) == 0 and cols.tolist() == [0, 1, 2]
-    np.testing.assert_allclose(iou_matrix([[0, 0, 10, 10]], [[5, 0, 10, 10], [20, 20, 1, 1]]), [[50 / 150, 0]])
+    np.testing.assert_allclose(corner_iou(np.array([[0.0, 0, 10, 10]]), np.array([[5.0, 0, 15, 10], [20, 20, 21, 21]])),
+                               [[50 / 150, 0]])
 
 
 def test_trackers_never_import_the_simulator():

@@ -9,16 +9,6 @@ from scipy.optimize import linear_sum_assignment
 from scipy.special import chdtri
 
 
-def iou_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """IoU (len(a), len(b)) of boxes x, y, w, h."""
-    a, b = np.asarray(a, float).reshape(-1, 4), np.asarray(b, float).reshape(-1, 4)
-    iw = np.minimum(a[:, None, 0] + a[:, None, 2], b[:, 0] + b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0])
-    ih = np.minimum(a[:, None, 1] + a[:, None, 3], b[:, 1] + b[:, 3]) - np.maximum(a[:, None, 1], b[:, 1])
-    inter = np.maximum(iw, 0) * np.maximum(ih, 0)
-    union = (a[:, 2] * a[:, 3])[:, None] + b[:, 2] * b[:, 3] - inter
-    return inter / np.maximum(union, 1e-12)
-
-
 def corner_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """IoU (len(a), len(b)) of boxes x1, y1, x2, y2, computed as the SORT reference code does."""
     w = np.maximum(0.0, np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]))

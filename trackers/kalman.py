@@ -2,7 +2,8 @@
 
 A `KalmanBank` holds N independent filters that share their model matrices as stacked arrays
 (x: (N, d), P: (N, d, d)), so predicting or updating every track is a few batched matrix
-products instead of a Python loop over track objects.
+products instead of a Python loop over track objects. The `xyah_*` functions are ByteTrack's filter, whose
+noise scales with each box's height, on stacked means and covariances in the same way.
 """
 
 from __future__ import annotations
@@ -49,60 +50,40 @@ def stop_shrinking_to_nothing(bank: "KalmanBank") -> None:
     bank.x[bank.x[:, 2] + bank.x[:, 6] <= 0, 6] = 0.0
 
 
-def boxes_to_z(boxes: np.ndarray) -> np.ndarray:
-    """x, y, w, h -> SORT's measurement cx, cy, s, r."""
-    boxes = np.asarray(boxes, float).reshape(-1, 4)
-    w, h = boxes[:, 2], boxes[:, 3]
-    return np.stack([boxes[:, 0] + w / 2, boxes[:, 1] + h / 2, w * h, w / np.maximum(h, 1e-9)], axis=1)
-
-
-def z_to_boxes(z: np.ndarray) -> np.ndarray:
-    """SORT's cx, cy, s, r (first four state entries) -> x, y, w, h."""
-    s, r = np.maximum(z[:, 2], 0.0), np.maximum(z[:, 3], 1e-9)
-    w = np.sqrt(s * r)
-    h = s / np.maximum(w, 1e-9)
-    return np.stack([z[:, 0] - w / 2, z[:, 1] - h / 2, w, h], axis=1)
-
-
 # ByteTrack's filter (DeepSORT's): state (cx, cy, aspect, height) and their velocities, noise proportional to the height
 _POSITION, _VELOCITY = 1 / 20, 1 / 160
 _F8, _H8 = np.eye(8) + np.eye(8, k=4), np.eye(4, 8)
 
 
-def _height_scaled(h: np.ndarray, weights, aspect: float) -> np.ndarray:
-    """(n, len(weights)) standard deviations: weight x height, and `aspect` for the aspect entries (index 2 of 4)."""
-    std = np.asarray(weights)[None, :] * h[:, None]
-    std[:, 2::4] = aspect
-    return std
+def _variances(height: np.ndarray, weights: list[float], fixed: dict[int, float]) -> np.ndarray:
+    """(n, d, d) diagonal covariances: standard deviation weight x height per entry, except the `fixed` entries."""
+    std = np.outer(height, weights)
+    for i, value in fixed.items():
+        std[:, i] = value
+    out = np.zeros(std.shape + std.shape[-1:])
+    idx = np.arange(std.shape[1])
+    out[:, idx, idx] = std**2
+    return out
 
 
 def xyah_initiate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """New tracks at measurements z (n, 4) cx, cy, aspect, height: means (n, 8) and covariances (n, 8, 8)."""
-    std = _height_scaled(z[:, 3], [2 * _POSITION] * 4 + [10 * _VELOCITY] * 4, 0.0)
-    std[:, 2], std[:, 6] = 1e-2, 1e-5
-    return np.c_[z, np.zeros_like(z)], _diag(std**2)
+    cov = _variances(z[:, 3], [2 * _POSITION] * 4 + [10 * _VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
+    return np.c_[z, np.zeros_like(z)], cov
 
 
 def xyah_predict(mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """One constant-velocity step, with process noise scaled by each track's height."""
-    std = _height_scaled(mean[:, 3], [_POSITION] * 4 + [_VELOCITY] * 4, 0.0)
-    std[:, 2], std[:, 6] = 1e-2, 1e-5
-    return mean @ _F8.T, _F8 @ cov @ _F8.T + _diag(std**2)
+    noise = _variances(mean[:, 3], [_POSITION] * 4 + [_VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
+    return mean @ _F8.T, _F8 @ cov @ _F8.T + noise
 
 
 def xyah_update(mean: np.ndarray, cov: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Correct with measurements z (n, 4), measurement noise scaled by the predicted height."""
-    S = _H8 @ cov @ _H8.T + _diag(_height_scaled(mean[:, 3], [_POSITION] * 4, 1e-1) ** 2)
+    S = _H8 @ cov @ _H8.T + _variances(mean[:, 3], [_POSITION] * 4, {2: 1e-1})
     K = np.linalg.solve(S, _H8 @ cov).transpose(0, 2, 1)  # P H^T S^-1
     innovation = z - mean @ _H8.T
     return mean + np.einsum("nij,nj->ni", K, innovation), cov - K @ S @ K.transpose(0, 2, 1)
-
-
-def _diag(v: np.ndarray) -> np.ndarray:
-    out = np.zeros(v.shape + v.shape[-1:])
-    idx = np.arange(v.shape[-1])
-    out[:, idx, idx] = v
-    return out
 
 
 class KalmanBank:

@@ -1,7 +1,7 @@
 """Track bookkeeping as arrays: ids, hit and miss counters, state, score, and the filters they own.
 
-States follow the usual life cycle: TENTATIVE (new, not yet reported) -> CONFIRMED -> LOST (coasting
-without detections) -> deleted (removed from the book).
+States follow the usual life cycle: TENTATIVE (new, not yet reported) -> CONFIRMED -> deleted (removed from
+the book).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 
 from .kalman import KalmanBank
 
-TENTATIVE, CONFIRMED, LOST = 0, 1, 2
+TENTATIVE, CONFIRMED = 0, 1
 
 
 class TrackBook:
