@@ -24,11 +24,12 @@ from .sequence import Recording
 from .metrics import EpisodeMetrics, FrameStats
 from .overlay import draw_overlay
 from .render import Renderer
-from .sensor import Detections, make_sensor
+from .sensor import Detections, SyntheticSensor, make_sensor
 from .truth import Truth, measure
 from .world import World
 
-_SPACE_KEYS = ("render.width", "render.height", "sensor.max_detections", "env.max_tracks", "env.obs_mode")
+_SPACE_KEYS = ("render.width", "render.height", "sensor.model", "sensor.max_detections", "sensor.conf_offset",
+               "sensor.conf_scale", "env.max_tracks", "env.obs_mode")
 _TRAIL = 12
 
 NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}  # the action that reports nothing
@@ -61,7 +62,10 @@ class TrackingEnv(gym.Env):
     **Recorded sequences** ``TrackingEnv("path/to/MOT17-02")`` or ``gym.make("mtt_sim/Replay-v0",
     sequence=...)``: detections as written, in float64, bounded by the extremes of the sequence's det.txt
     (raw confidences included); action boxes in float64; ground truth scored as TrackEval scores the
-    benchmark (``benchmark=`` overrides the guess from the name and the columns); no gt/: unscored.
+    benchmark (``benchmark=`` overrides the guess from the name and the columns); no gt/: unscored. With
+    ``sensor="fitted.toml"`` (a file from ``mtt-sim calibrate``) or ``config={"sensor.model": "synthetic"}`` the
+    sequence's ground truth is replayed through the synthetic detector instead (its digital twin), seeded like a
+    scenario. ``sensor=`` loads a detector file onto a simulated scenario too.
 
     **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
     trackers initialised by hand, ``image_size`` (width, height), ``frame_rate`` and ``length`` (frames;
@@ -74,8 +78,10 @@ class TrackingEnv(gym.Env):
 
     def __init__(self, scenario: str | os.PathLike | scn.Scenario | None = "crossing", config: Mapping | None = None,
                  render_mode: str | None = None, obs_mode: str | None = None, sequence: str | os.PathLike | None = None,
-                 benchmark: str | None = None):
+                 benchmark: str | None = None, sensor: str | os.PathLike | None = None):
         overrides = scn.expand_dotted(config or {})
+        if sensor is not None:  # a fitted detector's file; keys in `config` win
+            overrides = scn.merge(scn.read_sensor(sensor), overrides)
         if obs_mode is not None:
             overrides = scn.merge(overrides, {"env": {"obs_mode": obs_mode}})
         source = sequence if sequence is not None else scenario
@@ -111,13 +117,16 @@ class TrackingEnv(gym.Env):
 
     @staticmethod
     def _spaces(sc: scn.Scenario, recording: Recording | None = None):
-        """Simulated detections lie in the image with confidences in [0, 1] (float32); recorded ones are given as
-        written (float64), so their bounds are those widened to the extremes of the sequence's det.txt."""
+        """Simulated detections lie in the image with confidences in conf_offset + [0, conf_scale] (float32; float64
+        on a recorded sequence); recorded ones are given as written, so their bounds are widened to the extremes of
+        the sequence's det.txt."""
         w, h = sc.render.width, sc.render.height
         nd, nt = sc.sensor.max_detections, sc.env.max_tracks
         dtype = np.float32 if recording is None else np.float64
-        det_low, det_high = np.zeros(5), np.array([w, h, w, h, 1.0])
-        if recording is not None:
+        s = sc.sensor
+        det_low = np.array([0, 0, 0, 0, s.conf_offset])
+        det_high = np.array([w, h, w, h, s.conf_offset + s.conf_scale])
+        if recording is not None and s.model == "recorded":
             det_low = np.minimum(det_low, np.floor(recording.det_range[0]))
             det_high = np.maximum(det_high, np.ceil(recording.det_range[1]))
         obs = {"detections": spaces.Box(np.tile(det_low.astype(dtype), (nd, 1)), np.tile(det_high.astype(dtype), (nd, 1)),
@@ -151,6 +160,8 @@ class TrackingEnv(gym.Env):
                 self.renderer.camera.follow(self.world)
             empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
             self.sensor = make_sensor(sc, sensor_rng, empty)
+        else:
+            self.sensor = SyntheticSensor(sc, sensor_rng) if sc.sensor.model == "synthetic" else None
         self._started = True
         s = sc.scoring
         self.metrics = EpisodeMetrics(s.similarity, s.threshold, s.zero_distance, s.gospa_c, s.gospa_p)
@@ -242,11 +253,15 @@ class TrackingEnv(gym.Env):
     def _read(self, want_frame: bool) -> None:
         """The recorded sequence's current frame: truth, detections and (if wanted) the image."""
         rec, k = self.recording, self.steps
-        self.truth, rows = rec.truth(k), rec.detections(k)
+        self.truth = rec.truth(k)
         self.frame = rec.image(k) if want_frame and rec.has_images and k < len(rec) else None
         if want_frame and self.frame is None:  # past the end, or a sequence without images being rendered
             self.frame = np.zeros((self.scenario.render.height, self.scenario.render.width, 3), np.uint8)
-        self.detections = Detections(rows, np.full(len(rows), -1, np.int64))
+        if self.sensor is not None:  # the twin: the synthetic detector on the recorded people
+            self.detections = self.sensor.detect(self.truth)
+        else:
+            rows = rec.detections(k)
+            self.detections = Detections(rows, np.full(len(rows), -1, np.int64))
 
     # ------------------------------------------------------------ actions
 

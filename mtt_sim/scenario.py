@@ -135,7 +135,7 @@ class RenderConfig:
 
 
 PRESETS: dict[str, dict[str, Any]] = {
-    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0,
+    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_size_noise=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0,
                   clutter_rate=0.0, conf_true=0.95, conf_false=0.3),
     "dpm": dict(pd=0.8, min_visibility=0.3, box_noise=0.08, box_scale=1.15, fragment_prob=0.03, merge_prob=0.3,
                 clutter_rate=3.0, conf_true=0.6, conf_false=0.35, conf_spread=5.0),
@@ -148,22 +148,65 @@ PRESETS: dict[str, dict[str, Any]] = {
 
 @dataclass(frozen=True)
 class SensorConfig:
-    """The simulated detector. Keys given explicitly override the chosen preset's values."""
+    """The simulated detector. Keys given explicitly override the chosen preset's values.
 
-    model: str = spec("synthetic", "synthetic: from the label map; foreground: background subtraction on the frame",
-                      choices=("synthetic", "foreground"))
-    preset: str = spec("", "fill the keys below from a detector preset (MOT17's public detectors)", choices=("",) + tuple(PRESETS))
-    pd: float = spec(0.95, "detection probability at full visibility", "", 0.0, 1.0)
-    min_visibility: float = spec(0.2, "no detection below this visible fraction; pd rises linearly above it", "", 0.0, 1.0)
-    box_noise: float = spec(0.03, "box jitter standard deviation relative to the box size", "", 0.0, 1.0)
+    `synthetic` detects a target with a probability logistic in its visible fraction and height, raised after a
+    detection and lowered after a miss (`miss_corr`); boxes carry per-frame noise, occasional outliers and a per-target
+    drift; false positives are fresh clutter plus persistent sites; confidences are Beta-distributed by source.
+    """
+
+    model: str = spec("synthetic", "synthetic: from the truth and the label map; foreground: background subtraction on "
+                      "the frame; recorded: a sequence folder's det/det.txt (its default; synthetic replays its ground "
+                      "truth through the synthetic detector instead)", choices=("synthetic", "foreground", "recorded"))
+    preset: str = spec("", "fill the keys below from a detector preset (see README: what each is fitted to)",
+                       choices=("",) + tuple(PRESETS))
+    memory: bool = spec(True, "errors persist: misses follow each target's last outcome, boxes drift, false-positive "
+                        "sites last site_life frames; false: every frame drawn independently with the same rates")
+    pd: float = spec(0.95, "P(detect) of a fully visible target at least reference_height tall (its recall over time)", "",
+                     0.0, 1.0)
+    miss_corr: float = spec(0.5, "frame-to-frame correlation of a target's misses: P(detect) is P + (1 - P) miss_corr "
+                            "after a detection and P (1 - miss_corr) after a miss", "", 0.0, 0.999)
+    visibility_slope: float = spec(4.0, "logit of P(detect) gained per unit of visible fraction", "logit", 0.0, 100.0)
+    height_slope: float = spec(0.0, "logit of P(detect) lost per halving of the box height below reference_height",
+                               "logit", -10.0, 10.0)
+    reference_height: float = spec(100.0, "box height from which pd holds (taller is no easier)", "px", 1.0, 1e4)
+    min_visibility: float = spec(0.2, "never detected at or below this visible fraction", "", 0.0, 1.0)
+    box_noise: float = spec(0.03, "per-frame noise of the box centre, across and down, in units of the box's scale "
+                            "sqrt(w h) (standard deviation)", "", 0.0, 1.0)
+    box_size_noise: float = spec(0.03, "per-frame noise of the box width and height, in units of sqrt(w h)", "",
+                                 0.0, 1.0)
+    box_drift: float = spec(0.0, "per-target drift of centre and size, AR(1) with this stationary standard deviation "
+                            "(units of sqrt(w h)), on top of the per-frame noise", "", 0.0, 1.0)
+    box_drift_corr: float = spec(0.9, "frame-to-frame correlation of the box drift", "", 0.0, 0.999)
+    box_outlier_prob: float = spec(0.0, "probability a detection's box is an outlier (IoU 0.3-0.5 with its target's) "
+                                   "when the target's last box was good", "", 0.0, 1.0)
+    box_outlier_persist: float = spec(0.0, "the same when its last box was an outlier, or it was missed or new (poor "
+                                      "boxes persist, and a target coming back is often boxed poorly)", "", 0.0, 1.0)
+    box_outlier_noise: float = spec(0.3, "spread of outlier boxes and of sites held beside a target (units of "
+                                    "sqrt(w h))", "", 0.01, 2.0)
     box_scale: float = spec(1.0, "systematic box enlargement (loose boxes > 1)", "", 0.5, 2.0)
+    box_aspect: float = spec(1.0, "systematic widening relative to the height (> 1: boxes too wide)", "", 0.25, 4.0)
     fragment_prob: float = spec(0.02, "probability a visible target is reported as 2-3 fragments "
                                 "(always when an occluder cuts it apart)", "", 0.0, 1.0)
     merge_prob: float = spec(0.5, "probability targets whose visible regions touch are reported as one box", "", 0.0, 1.0)
-    clutter_rate: float = spec(0.5, "Poisson mean of false detections per frame", "1/frame", 0.0, 1000.0)
-    conf_true: float = spec(0.85, "mean confidence of a fully visible target's detection", "", 0.01, 0.99)
+    clutter_rate: float = spec(0.5, "Poisson mean of fresh false detections per frame (each lasts one frame)", "1/frame",
+                               0.0, 1000.0)
+    site_rate: float = spec(0.0, "Poisson mean of persistent false-alarm sites born per frame", "1/frame", 0.0, 100.0)
+    site_life: float = spec(10.0, "mean life of a site (geometric; it fires every frame it lives)", "frames", 1.0, 1e5)
+    site_near: float = spec(0.5, "share of sites born beside a visible target (IoU 0.1-0.3 with it), moving with it "
+                            "(double and partial boxes); the rest are static background boxes", "", 0.0, 1.0)
+    conf_true: float = spec(0.85, "mean confidence of a detection of a fully visible target at least reference_height tall",
+                            "", 0.01, 0.99)
+    conf_visibility: float = spec(2.0, "logit of the mean true confidence gained per unit of visible fraction",
+                                  "logit", 0.0, 100.0)
+    conf_height: float = spec(0.0, "logit of the mean true confidence lost per halving of the box height below "
+                              "reference_height", "logit", -10.0, 10.0)
     conf_false: float = spec(0.35, "mean confidence of a false detection", "", 0.01, 0.99)
-    conf_spread: float = spec(8.0, "Beta concentration of the confidence distributions (higher = tighter)", "", 0.5, 1000.0)
+    conf_spread: float = spec(8.0, "Beta concentration of the true confidences (higher = tighter)", "", 0.5, 1e4)
+    conf_false_spread: float = spec(0.0, "Beta concentration of the false confidences (0 = conf_spread)", "", 0.0, 1e4)
+    conf_offset: float = spec(0.0, "reported confidence = conf_offset + conf_scale * Beta draw (raw scores like DPM's)",
+                              "", -1e4, 1e4)
+    conf_scale: float = spec(1.0, "see conf_offset", "", 1e-6, 1e4)
     min_area: float = spec(20.0, "foreground: smallest blob kept", "px^2", 0.0, 1e6)
     threshold: float = spec(25.0, "foreground: grey-level difference that counts as foreground", "grey levels", 1.0, 255.0)
     learning_rate: float = spec(0.02, "foreground: background model update rate on background pixels", "", 0.0, 1.0)
@@ -561,7 +604,25 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
         except ConfigError as err:
             raise ConfigError(f"{where}: {err}") from None
         where += " (with overrides)"
-    return from_mapping(raw, where)
+    sc = from_mapping(raw, where)
+    if sc.sensor.model == "recorded":
+        raise ConfigError(f"{where}: sensor.model = 'recorded' replays a sequence folder's det/det.txt; a scenario's "
+                          "detector is 'synthetic' or 'foreground'")
+    return sc
+
+
+def read_sensor(path: str | Path) -> dict:
+    """The [sensor] table of a TOML file (as `mtt-sim calibrate` writes), to be merged into a scenario's overrides."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such sensor file (a TOML file with a [sensor] table, e.g. from mtt-sim calibrate)")
+    try:
+        table = tomllib.loads(path.read_text()).get("sensor")
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: invalid TOML: {err}") from None
+    if not isinstance(table, Mapping):
+        raise ConfigError(f"{path}: expected a [sensor] table")
+    return {"sensor": dict(table)}
 
 
 def reference_table() -> str:

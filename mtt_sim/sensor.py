@@ -1,11 +1,16 @@
 """Simulated detectors: turn one frame's truth (or its pixels) into boxes with confidences.
 
-``synthetic`` reads the label map: each visible target is detected with a probability that rises
-with its visible fraction, reported as its visible extent plus noise, possibly merged with targets
-whose visible regions touch, possibly split into fragments (always where an occluder cuts it
-apart); Poisson clutter is added; confidences are Beta-distributed, higher for true detections and
-rising with visibility. ``foreground`` runs background subtraction, morphology and connected
-components on the rendered frame, so fragments and merges come from the image itself.
+``synthetic`` reads the truth (and the label map, where there is one) and fails the way real detectors fail
+(``mtt_sim.calibrate`` fits it to real detections):
+- misses: P(detect) is logistic in the visible fraction and the log of the box height, raised for a target detected
+  in the previous frame and lowered after a miss (a two-state Markov chain per target), so misses come in runs;
+- boxes: the visible extent with per-frame noise and a per-target AR(1) drift of offset and size, true detections
+  (IoU >= 0.5 with it); some are outliers (IoU 0.3-0.5), more often after an outlier or a miss; targets whose visible regions touch may merge into one box; fragments (always where an occluder cuts a target
+  apart);
+- false positives: fresh Poisson clutter and persistent sites, static or held beside a target;
+- confidences: Beta draws, their mean for true detections logistic in visibility and height.
+With ``memory = false`` every frame is drawn independently at the same rates. ``foreground`` runs background
+subtraction, morphology and connected components on the rendered frame, so fragments and merges come from the image.
 """
 
 from __future__ import annotations
@@ -14,12 +19,18 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy.special import expit, logit
 
 from .scenario import Scenario, SensorConfig
 from .truth import Truth, clip_boxes, overlapping_pairs
 
 CLUTTER = -1   # source of a false detection
 UNKNOWN = 0    # source of a foreground blob (the image does not say which target made it)
+TRUE_BAND = (0.5, 1.01)    # IoU with its target of a true detection's box (its noise is drawn within)
+OUTLIER_BAND = (0.3, 0.5)  # IoU with its target of an outlier box: detected, badly (calibrate associates at 0.3)
+BESIDE_BAND = (0.1, 0.3)   # IoU with its target of a site held beside it: a false positive, not its detection
+_BAND_TRIES = 8
+MISSED, GOOD, POOR = 0, 1, 2  # how a target was reported: not at all, with a true box, with an outlier box
 
 
 @dataclass(frozen=True)
@@ -30,13 +41,28 @@ class Detections:
     sources: np.ndarray  # (n,) int64: target id, CLUTTER or UNKNOWN
 
 
-def detection_probability(visibility: np.ndarray, cfg: SensorConfig) -> np.ndarray:
-    """pd ** (1 / ramp), ramp = (visibility - min_visibility) / (1 - min_visibility) in (0, 1]; 0 where ramp <= 0.
+def detection_probabilities(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig):
+    """(P, P(detect | detected before), P(detect | missed before)) per target.
 
-    pd at full view, rising with visibility, none at or below min_visibility, and every visible target when pd = 1.
+    logit P = logit(pd) + visibility_slope (visibility - 1) + height_slope log_height, 0 at or below min_visibility. A two-state chain with lag-1 correlation miss_corr has P as its long-run share of detected
+    frames: after a detection P + (1 - P) miss_corr, after a miss P (1 - miss_corr).
     """
-    ramp = np.clip((visibility - cfg.min_visibility) / max(1e-9, 1 - cfg.min_visibility), 0, 1)
-    return np.where(ramp > 0, cfg.pd ** (1 / np.maximum(ramp, 1e-9)), 0.0)
+    shift = cfg.visibility_slope * (visibility - 1) + cfg.height_slope * log_height(height, cfg)
+    with np.errstate(divide="ignore"):
+        p = np.where(visibility > cfg.min_visibility, expit(logit(cfg.pd) + shift), 0.0)
+    return p, p + (1 - p) * cfg.miss_corr, p * (1 - cfg.miss_corr)
+
+
+def log_height(height: np.ndarray, cfg: SensorConfig) -> np.ndarray:
+    """min(0, log2(height / reference_height)): the size covariate of detection and confidence (a detector finds small
+    people harder; above some height, size no longer helps)."""
+    return np.minimum(np.log2(np.maximum(height, 1e-3) / cfg.reference_height), 0.0)
+
+
+def true_confidence(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig) -> np.ndarray:
+    """Mean confidence (before conf_offset / conf_scale) of a true detection: logit(conf_true) + conf_visibility
+    (visibility - 1) + conf_height log_height, through the logistic."""
+    return expit(logit(cfg.conf_true) + cfg.conf_visibility * (visibility - 1) + cfg.conf_height * log_height(height, cfg))
 
 
 def _union(boxes: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
@@ -79,33 +105,66 @@ def _split(box: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
     gap = 0.05 * length
     out = np.repeat(box[None], k, axis=0)
     out[:, axis] = box[axis] + edges[:-1] + np.where(np.arange(k) > 0, gap / 2, 0)
-    out[:, 2 + axis] = np.diff(edges) - gap / 2 * ((np.arange(k) > 0) + (np.arange(k) < k - 1))
-    return out
+    out[:, 2 + axis] = np.maximum(np.diff(edges) - gap / 2 * ((np.arange(k) > 0) + (np.arange(k) < k - 1)), 0)
+    return out  # a fragment squeezed to nothing between close cuts is dropped with the degenerate boxes
+
+
+def displace(boxes: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Boxes x, y, w, h with their centres moved by offsets[:, :2] and their widths and heights grown by
+    offsets[:, 2:], all in units of the box's scale sqrt(w h) (a real detector's pixel errors scale with it, alike
+    across and down); a size keeps at least a tenth of what it was."""
+    s = np.sqrt(np.prod(boxes[:, 2:], axis=1))[:, None]
+    c = boxes[:, :2] + boxes[:, 2:] / 2 + offsets[:, :2] * s
+    wh = np.maximum(boxes[:, 2:] + offsets[:, 2:] * s, 0.1 * boxes[:, 2:])
+    return np.concatenate([c - wh / 2, wh], axis=1)
+
+
+def pair_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """IoU of boxes a[..., i] and b[..., i] pairwise (broadcasting over the leading axes)."""
+    lo = np.maximum(a[..., :2], b[..., :2])
+    hi = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])
+    inter = np.prod(np.clip(hi - lo, 0, None), axis=-1)
+    return inter / np.maximum(np.prod(a[..., 2:], axis=-1) + np.prod(b[..., 2:], axis=-1) - inter, 1e-12)
+
+
+def offsets_in_band(boxes: np.ndarray, base: np.ndarray, mean: np.ndarray, sigma: np.ndarray, band: tuple[float, float],
+                    rng: np.random.Generator, fallback: np.ndarray) -> np.ndarray:
+    """Offsets N(mean, sigma) (see `displace`) that move `base` boxes to an IoU in [band) with `boxes`: for each,
+    the first of a few draws that does, else its `fallback`."""
+    n = len(boxes)
+    tries = mean[:, None] + rng.normal(0, 1, (n, _BAND_TRIES, 4)) * sigma
+    moved = displace(np.repeat(base, _BAND_TRIES, axis=0), tries.reshape(-1, 4)).reshape(n, _BAND_TRIES, 4)
+    iou = pair_iou(boxes[:, None], moved)
+    good = (iou >= band[0]) & (iou < band[1])
+    return np.where(good.any(axis=1)[:, None], tries[np.arange(n), np.argmax(good, axis=1)], fallback)
+
+
+def astray(boxes: np.ndarray, spread: float, band: tuple[float, float], rng: np.random.Generator) -> np.ndarray:
+    """Offsets of boxes at an IoU in [band) with their own (outliers, sites beside a target): normal with this spread,
+    else a sideways shift to the band's middle (by f of the width, a box overlaps itself at IoU (1 - f) / (1 + f))."""
+    mid = sum(band) / 2
+    sideways = np.zeros((len(boxes), 4))
+    sideways[:, 0] = np.where(rng.random(len(boxes)) < 0.5, -1, 1) * (1 - mid) / (1 + mid) * np.sqrt(boxes[:, 2] / boxes[:, 3])
+    return offsets_in_band(boxes, boxes, np.zeros((len(boxes), 4)), np.full(4, spread), band, rng, sideways)
 
 
 class Sensor:
-    """What both detector models share: box noise, confidences, clutter and the observation limits."""
+    """What both detector models share: clutter, confidences and the observation limits."""
 
     def __init__(self, sc: Scenario, rng: np.random.Generator):
         self.cfg, self.rng = sc.sensor, rng
         self.size = (sc.render.width, sc.render.height)
         self.nominal = np.array([g.size for g in sc.groups], float)
 
-    def _confidence(self, mean: np.ndarray) -> np.ndarray:
-        k = self.cfg.conf_spread
+    def _confidence(self, mean: np.ndarray, false: np.ndarray) -> np.ndarray:
+        """Beta draws of the given means (conf_spread, or conf_false_spread for false ones), offset and scaled."""
+        cfg = self.cfg
+        k = np.where(false & (cfg.conf_false_spread > 0), cfg.conf_false_spread, cfg.conf_spread)
         mean = np.clip(mean, 1e-3, 1 - 1e-3)
-        return self.rng.beta(mean * k, (1 - mean) * k)
+        return cfg.conf_offset + cfg.conf_scale * self.rng.beta(mean * k, (1 - mean) * k)
 
-    def _jitter(self, boxes: np.ndarray) -> np.ndarray:
-        """Centre noise and size noise proportional to the box size, and the systematic scale."""
-        noise = self.rng.normal(0, self.cfg.box_noise, (len(boxes), 4))
-        c = boxes[:, :2] + boxes[:, 2:] / 2 + noise[:, :2] * boxes[:, 2:]
-        wh = boxes[:, 2:] * self.cfg.box_scale * np.exp(noise[:, 2:])
-        return np.concatenate([c - wh / 2, wh], axis=1)
-
-    def _clutter(self, truth: Truth) -> np.ndarray:
-        """Poisson false boxes, uniformly placed, sized like the current targets."""
-        n = self.rng.poisson(self.cfg.clutter_rate)
+    def random_boxes(self, n: int, truth: Truth) -> np.ndarray:
+        """n boxes placed uniformly in the image, sized like the current targets."""
         if not n:
             return np.zeros((0, 4))
         pool = truth.boxes[:, 2:] if len(truth) else self.nominal
@@ -115,75 +174,218 @@ class Sensor:
         return np.concatenate([xy, wh], axis=1)
 
     def _finish(self, boxes: np.ndarray, mean_conf: np.ndarray, sources: np.ndarray, truth: Truth) -> Detections:
-        """Add clutter, draw confidences, clip to the image, drop degenerate boxes, shuffle, keep max_detections."""
-        cb = self._clutter(truth)
-        if len(cb):
-            boxes = np.concatenate([boxes, cb])
-            mean_conf = np.concatenate([mean_conf, np.full(len(cb), self.cfg.conf_false)])
-            sources = np.concatenate([sources, np.full(len(cb), CLUTTER)])
-        conf = self._confidence(mean_conf)
+        """Add fresh clutter, draw confidences, clip to the image, drop degenerate boxes, shuffle, keep max_detections."""
+        cb = self.random_boxes(self.rng.poisson(self.cfg.clutter_rate), truth)
+        boxes = np.concatenate([boxes, cb])
+        mean_conf = np.concatenate([mean_conf, np.full(len(cb), self.cfg.conf_false)])
+        sources = np.concatenate([sources, np.full(len(cb), CLUTTER)]).astype(np.int64)
+        conf = self._confidence(mean_conf, sources == CLUTTER)
         boxes = clip_boxes(boxes, *self.size)
         order = self.rng.permutation(np.flatnonzero((boxes[:, 2] >= 1) & (boxes[:, 3] >= 1)))
         if len(order) > self.cfg.max_detections:  # keep the most confident, in their shuffled order
             order = order[np.sort(np.argsort(-conf[order], kind="stable")[: self.cfg.max_detections])]
         rows = np.empty((len(order), 5), np.float32)
         rows[:, :4], rows[:, 4] = boxes[order], conf[order]
-        return Detections(rows, sources[order].astype(np.int64))
+        return Detections(rows, sources[order])
+
+
+class _Memory:
+    """Per target id, from the last frame it was seen: how it was reported (MISSED, GOOD, POOR), its box drift and
+    the offsets of its outlier box (kept while it stays poor)."""
+
+    def __init__(self):
+        self.ids, self.state, self.offsets = np.zeros(0, np.int64), np.zeros(0, np.int8), np.zeros((0, 8))
+
+    def recall(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(known, state, drift, outlier offsets) for each id; unknown ids get MISSED and zeros."""
+        row = _rows_of(self.ids, ids)
+        known = row >= 0
+        if not known.any():
+            return known, np.zeros(len(ids), np.int8), np.zeros((len(ids), 4)), np.zeros((len(ids), 4))
+        r = np.where(known, row, 0)
+        offsets = np.where(known[:, None], self.offsets[r], 0.0)
+        return known, np.where(known, self.state[r], MISSED), offsets[:, :4], offsets[:, 4:]
+
+    def store(self, ids: np.ndarray, state: np.ndarray, drift: np.ndarray, poor: np.ndarray) -> None:
+        """Keep these targets' outcomes; targets absent from this frame are forgotten."""
+        order = np.argsort(ids, kind="stable")
+        self.ids, self.state, self.offsets = ids[order], state[order], np.c_[drift, poor][order]
+
+
+class _Sites:
+    """Persistent false-alarm sites: static background boxes, and boxes held beside a target that move with it."""
+
+    def __init__(self):
+        self.owner = np.zeros(0, np.int64)  # target id a site is held beside, or -1 (static)
+        self.shape = np.zeros((0, 4))       # static: x, y, w, h; beside a target: offsets in its box sizes
+
+    def fire(self, sensor: SyntheticSensor, truth: Truth) -> np.ndarray:
+        """Age, kill and bear sites for this frame; the boxes the living sites report."""
+        cfg, rng = sensor.cfg, sensor.rng
+        life, rate = (cfg.site_life, cfg.site_rate) if cfg.memory else (1.0, cfg.site_rate * cfg.site_life)
+        if not rate and not len(self.owner):
+            return np.zeros((0, 4))
+        visible = truth.visibility > cfg.min_visibility
+        row = _rows_of(truth.ids, self.owner)
+        keep = (rng.random(len(self.owner)) >= 1 / life) & ((self.owner < 0) | (row >= 0))
+        n = rng.poisson(rate)
+        beside = (rng.random(n) < cfg.site_near) & visible.any()
+        targets = truth.ids[rng.choice(np.flatnonzero(visible), int(beside.sum()))] if beside.any() else []
+        owner = np.full(n, -1, np.int64)
+        owner[beside] = targets
+        shape = np.zeros((n, 4))
+        if beside.any():
+            shape[beside] = astray(truth.boxes[_rows_of(truth.ids, targets)].astype(float), cfg.box_outlier_noise,
+                                   BESIDE_BAND, rng)
+        shape[~beside] = sensor.random_boxes(int((~beside).sum()), truth)
+        self.owner = np.concatenate([self.owner[keep], owner])
+        self.shape = np.concatenate([self.shape[keep], shape])
+        row = _rows_of(truth.ids, self.owner)
+        static = self.owner < 0
+        shown = static | ((row >= 0) & np.r_[visible, False][row])  # row -1 picks the False
+        held = shown & ~static
+        out = self.shape[shown].copy()
+        out[held[shown]] = displace(truth.boxes[row[held]].astype(float), self.shape[held])
+        return out
+
+
+def _rows_of(ids: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Row of each wanted id in `ids` (unique), or -1."""
+    if not len(ids):
+        return np.full(len(wanted), -1)
+    order = np.argsort(ids)
+    pos = np.minimum(np.searchsorted(ids, wanted, sorter=order), len(ids) - 1)
+    return np.where(ids[order[pos]] == wanted, order[pos], -1)
 
 
 class SyntheticSensor(Sensor):
-    """Detections made from the label map and the truth (no image processing)."""
+    """Detections made from the truth and the label map (no image processing); without a label map (a recorded
+    sequence's ground truth) targets whose boxes overlap count as touching."""
 
-    def detect(self, truth: Truth, labels: np.ndarray, frame: np.ndarray | None = None) -> Detections:
+    def __init__(self, sc: Scenario, rng: np.random.Generator):
+        super().__init__(sc, rng)
+        self.memory, self.sites = _Memory(), _Sites()
+
+    def detect(self, truth: Truth, labels: np.ndarray | None = None, frame: np.ndarray | None = None) -> Detections:
         cfg, rng = self.cfg, self.rng
-        pd = detection_probability(truth.visibility, cfg)
-        cand = np.flatnonzero(pd > 0)
+        marginal, after_hit, after_miss = detection_probabilities(truth.visibility, truth.boxes[:, 3], cfg)
+        known, last, drift, poor = self.memory.recall(truth.ids)
+        pd = np.where(known, np.where(last != MISSED, after_hit, after_miss), marginal) if cfg.memory else marginal
+        drift = self._drift(known, drift)
+        cand = np.flatnonzero(truth.visibility > cfg.min_visibility)
         obj = self._merge_groups(truth, labels, cand)
+        box, p, lead = self._objects(truth, cand, obj, pd)
+        found = rng.random(len(lead)) < p
+        outlier = found & (rng.random(len(lead)) < self._outlier_probability(last[lead], marginal[lead]))
+        hit = found & ~outlier
+        if outlier.any():  # a new outlier box, or the same offsets as last frame's
+            fresh = astray(box[outlier], cfg.box_outlier_noise, OUTLIER_BAND, rng)
+            poor[lead[outlier]] = np.where((cfg.memory & (last[lead[outlier]] == POOR))[:, None], poor[lead[outlier]], fresh)
+        state = np.zeros(len(truth), np.int8)
+        state[cand] = np.where(hit, GOOD, np.where(outlier, POOR, MISSED))[obj]
+        self.memory.store(truth.ids, state, drift, poor)
+        boxes, means, rows, kind = self._reports(truth, box, lead, hit, outlier, np.bincount(obj) == 1)
+        if cfg.box_noise or cfg.box_size_noise or cfg.box_drift or cfg.box_scale != 1 or cfg.box_aspect != 1:
+            boxes[kind < 2] = self._noisy(boxes[kind < 2], drift[rows[kind < 2]], whole=kind[kind < 2] == 0)
+        if outlier.any():
+            boxes[kind == 2] = displace(box[outlier], poor[lead[outlier]])
+        false_boxes = self.sites.fire(self, truth)
+        false_boxes = displace(false_boxes, self._frame_noise(len(false_boxes), cfg.box_noise, cfg.box_size_noise))
+        return self._finish(np.concatenate([boxes, false_boxes]),
+                            np.concatenate([means, np.full(len(false_boxes), cfg.conf_false)]),
+                            np.concatenate([truth.ids[rows], np.full(len(false_boxes), CLUTTER)]), truth)
+
+    @staticmethod
+    def _objects(truth: Truth, cand: np.ndarray, obj: np.ndarray, pd: np.ndarray):
+        """Per object (a candidate target, or targets merged into one): its box, P(detect) (its members' largest)
+        and the target that names it (the member with the largest visible area)."""
         n_obj = int(obj.max()) + 1 if len(obj) else 0
         if n_obj == len(cand):  # nothing merged: one object per candidate target
-            box, p, vis, lead = truth.visible_boxes[cand], pd[cand], truth.visibility[cand], cand
-        else:
-            box = _union(truth.visible_boxes[cand], obj, n_obj)
-            p, vis = np.zeros(n_obj), np.zeros(n_obj)
-            np.maximum.at(p, obj, pd[cand])
-            np.maximum.at(vis, obj, truth.visibility[cand])
-            area = np.prod(truth.visible_boxes[cand, 2:], axis=1)
-            order = np.lexsort((area, obj))  # the member with the largest visible area names the object
-            lead = cand[order[np.r_[np.flatnonzero(np.diff(obj[order])), len(order) - 1]]]
-        single = np.bincount(obj, minlength=n_obj) == 1
-        hit = rng.random(n_obj) < p
-        mean = cfg.conf_true * (0.5 + 0.5 * vis)
+            return truth.visible_boxes[cand], pd[cand], cand
+        p = np.zeros(n_obj)
+        np.maximum.at(p, obj, pd[cand])
+        area = np.prod(truth.visible_boxes[cand, 2:], axis=1)
+        order = np.lexsort((area, obj))
+        return _union(truth.visible_boxes[cand], obj, n_obj), p, cand[order[np.r_[np.flatnonzero(np.diff(obj[order])),
+                                                                                   len(order) - 1]]]
+
+    def _reports(self, truth: Truth, box: np.ndarray, lead: np.ndarray, hit: np.ndarray, outlier: np.ndarray,
+                 single: np.ndarray):
+        """The true detections before noise: (boxes, mean confidences, target row of each, kind: 0 whole, 1 piece or
+        fragment, 2 outlier).
+        A detected target an occluder cuts apart is reported as its pieces, one split with fragment_prob as
+        fragments, the rest whole; outliers come last, whole."""
+        cfg, rng = self.cfg, self.rng
+        mean_of = true_confidence(truth.visibility, truth.boxes[:, 3], cfg)
+        mean = mean_of[lead]
         owners = truth.pieces[:, 0].astype(int)
-        cut = hit & single & np.isin(lead, owners) if len(owners) else np.zeros(n_obj, bool)  # cut apart: report pieces
-        split = hit & single & ~cut & (rng.random(n_obj) < cfg.fragment_prob)
+        cut = hit & single & np.isin(lead, owners) if len(owners) else np.zeros(len(lead), bool)
+        split = hit & single & ~cut & (rng.random(len(lead)) < cfg.fragment_prob)
         whole = hit & ~cut & ~split
-        mean_of = np.zeros(len(truth))
-        mean_of[lead] = mean
         piece = np.isin(owners, lead[cut]) if len(owners) else np.zeros(0, bool)
         boxes = [box[whole], truth.pieces[piece, 1:]]
         means = [mean[whole], 0.8 * mean_of[owners[piece]]]
-        sources = [truth.ids[lead[whole]], truth.ids[owners[piece]]]
+        rows = [lead[whole], owners[piece]]
         for o in np.flatnonzero(split):
             parts = _split(box[o], int(rng.integers(2, 4)), rng)
             boxes.append(parts)
             means.append(np.full(len(parts), 0.8 * mean[o]))
-            sources.append(np.full(len(parts), truth.ids[lead[o]]))
-        b = np.concatenate(boxes)
-        if cfg.box_noise or cfg.box_scale != 1:
-            b = self._jitter(b)
-        return self._finish(b, np.concatenate(means), np.concatenate(sources), truth)
+            rows.append(np.full(len(parts), lead[o]))
+        boxes.append(box[outlier])
+        means.append(mean[outlier])
+        rows.append(lead[outlier])
+        kind = np.repeat([0, 1] + [1] * int(split.sum()) + [2], [len(r) for r in rows])
+        return np.concatenate(boxes).astype(float), np.concatenate(means), np.concatenate(rows).astype(int), kind
 
-    def _merge_groups(self, truth: Truth, labels: np.ndarray, cand: np.ndarray) -> np.ndarray:
+    def _outlier_probability(self, last: np.ndarray, marginal: np.ndarray) -> np.ndarray:
+        """P(a detection's box is an outlier): box_outlier_prob after a good box, box_outlier_persist otherwise.
+        Without memory the share the two settle at, x = (P a + b (1 - P)) / (1 + P (a - b)) for P(detect) = P."""
+        a, b = self.cfg.box_outlier_prob, self.cfg.box_outlier_persist
+        if self.cfg.memory:
+            return np.where(last == GOOD, a, b)
+        return (marginal * a + b * (1 - marginal)) / (1 + marginal * (a - b))
+
+    def _drift(self, known: np.ndarray, drift: np.ndarray) -> np.ndarray:
+        """This frame's per-target box drift: AR(1) from the last for known targets, stationary for new ones."""
+        cfg = self.cfg
+        if not cfg.memory or cfg.box_drift == 0:
+            return np.zeros((len(known), 4))
+        rho = cfg.box_drift_corr
+        fresh = self.rng.normal(0, cfg.box_drift, (len(known), 4))
+        return np.where(known[:, None], rho * drift + np.sqrt(1 - rho**2) * fresh, fresh)
+
+    def _noisy(self, boxes: np.ndarray, drift: np.ndarray, whole: np.ndarray) -> np.ndarray:
+        """True boxes scaled by box_scale and box_aspect about their centres, with their target's drift and per-frame
+        noise; the noise of a whole box is drawn to keep it a true detection (IoU >= 0.5 with the box; where a few
+        draws miss that, drift alone). Without memory the drift's variance joins the per-frame noise."""
+        cfg = self.cfg
+        centre, size = cfg.box_noise, cfg.box_size_noise
+        if not cfg.memory:
+            centre, size = np.hypot(centre, cfg.box_drift), np.hypot(size, cfg.box_drift)
+        root = np.sqrt(cfg.box_aspect)
+        wh = boxes[:, 2:] * cfg.box_scale * np.array([root, 1 / root])
+        scaled = np.concatenate([boxes[:, :2] + (boxes[:, 2:] - wh) / 2, wh], axis=1)
+        offsets = drift + self._frame_noise(len(boxes), centre, size)
+        if whole.any():
+            offsets[whole] = offsets_in_band(boxes[whole], scaled[whole], drift[whole], np.array([centre, centre, size, size]),
+                                             TRUE_BAND, self.rng, drift[whole])
+        return displace(scaled, offsets)
+
+    def _frame_noise(self, n: int, centre: float, size: float) -> np.ndarray:
+        """Per-frame offsets (see `displace`): normal, centre noise across and down, size noise in width and height."""
+        return self.rng.normal(0, 1, (n, 4)) * np.array([centre, centre, size, size])
+
+    def _merge_groups(self, truth: Truth, labels: np.ndarray | None, cand: np.ndarray) -> np.ndarray:
         """Object index of each candidate: targets whose visible regions touch are linked with merge_prob."""
         n = len(cand)
         if n < 2 or self.cfg.merge_prob <= 0:
             return np.arange(n)
         vb = truth.visible_boxes[cand]
-        i, j = overlapping_pairs(vb, margin=1.0)
+        i, j = overlapping_pairs(vb, margin=1.0 if labels is not None else 0.0)
         linked = self.rng.random(len(i)) < self.cfg.merge_prob
         i, j = i[linked], j[linked]
-        if not len(i):
-            return np.arange(n)
+        if not len(i) or labels is None:
+            return components(n, i, j)
         h, w = labels.shape
         lo, hi = vb[:, :2], vb[:, :2] + vb[:, 2:]
         ok = np.zeros(len(i), bool)

@@ -7,7 +7,10 @@ a time when asked for. Ground truth is scored as TrackEval's MotChallenge2DBox s
   (person on vehicle, static person, distractor, reflection; MOT20 also non-MOT vehicle) are removed, then only
   pedestrians (class 1) whose `considered` column is not 0 are scored;
 - MOT15: no classes; rows whose `considered` column is 0 are not scored.
-The visibility column (MOT16/17/20) is read into the truth the env shows, and not used for scoring, as in TrackEval.
+The truth the env shows holds the people (classes a person detector fires on) with their visible fraction: the
+visibility column where the benchmark has one (MOT16/17/20; not used for scoring, as in TrackEval), else measured from
+box overlaps (the box whose bottom edge is lower is nearer). With `sensor.model = "synthetic"` the env replays that
+truth through the synthetic detector (a digital twin of the sequence) instead of reading det/det.txt.
 """
 
 from __future__ import annotations
@@ -24,11 +27,12 @@ from scipy.optimize import linear_sum_assignment
 from . import scenario as scn
 from .scenario import is_sequence
 from .metrics import EPS, box_iou
-from .truth import Truth
+from .truth import Truth, occlusion_visibility
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20")
 PEDESTRIAN = 1
 DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
+PEOPLE = (1, 2, 7, 8, 12)  # pedestrian, person on vehicle, static person, distractor, reflection
 VALID_CLASSES = range(1, 14)
 FRAME_RATE = 30.0  # where seqinfo.ini gives none
 
@@ -66,6 +70,7 @@ class Recording:
             raise scn.ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
         self._det = by_frame(det, self.info.length)
         self._gt = by_frame(_gt_table(gt, self.benchmark, gt_file), self.info.length)
+        self.has_visibility = gt is not None and gt.shape[1] > 8 and self.benchmark != "MOT15"
         self.has_images = (self.folder / self.info.image_dir).is_dir()
         counts = np.diff(self._det[1])
         self.max_detections = int(counts.max()) if len(counts) else 0
@@ -82,10 +87,12 @@ class Recording:
         return _frame_rows(self._gt, k)
 
     def truth(self, k: int) -> Truth:
-        """Every ground-truth row of frame k (scored or not) as the env's Truth; visibility from the file (MOT16/17/20)."""
+        """The people of frame k (scored or not) as the env's Truth, with their visible fraction."""
         g = self._gt_rows(k)
+        g = g[np.isin(g[:, 7], PEOPLE)]
         boxes, n = g[:, 2:6], len(g)
-        return Truth(ids=g[:, 1].astype(np.int64), boxes=boxes, visibility=g[:, 8], visible_boxes=boxes,
+        visibility = g[:, 8] if self.has_visibility else occlusion_visibility(boxes, self.info.width, self.info.height)
+        return Truth(ids=g[:, 1].astype(np.int64), boxes=boxes, visibility=visibility, visible_boxes=boxes,
                      depth=np.zeros(n), labels=np.zeros(n, int), pieces=np.zeros((0, 5)))
 
     def scoring(self, k: int, track_boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -115,12 +122,21 @@ class Recording:
 
     def scenario(self, overrides: Mapping | None = None) -> scn.Scenario:
         """The configuration the env runs this sequence with: image size, length and detection rows from the data;
-        only `env.*` and `scoring.*` keys can be overridden."""
+        `env.*` and `scoring.*` keys can be overridden, and `sensor.*` keys for the synthetic detector (the twin)."""
         overrides = scn.expand_dotted(overrides or {})
-        other = sorted(set(overrides) - {"env", "scoring"})
+        other = sorted(set(overrides) - {"env", "scoring", "sensor"})
         if other:
-            raise scn.ConfigError(f"{self.folder}: a recorded sequence takes only env.* and scoring.* overrides, not "
-                                  f"{other[0]}.*")
+            raise scn.ConfigError(f"{self.folder}: a recorded sequence takes only env.*, scoring.* and sensor.* "
+                                  f"overrides, not {other[0]}.*")
+        sensor = overrides.get("sensor", {})
+        model = sensor.get("model", "recorded")
+        if model == "foreground":
+            raise scn.ConfigError(f"{self.folder}: sensor.model = 'foreground' needs frames the simulator rendered; "
+                                  "a recorded sequence takes 'recorded' (its det/det.txt) or 'synthetic' (its twin)")
+        if model == "recorded" and set(sensor) - {"model"}:
+            key = sorted(set(sensor) - {"model"})[0]
+            raise scn.ConfigError(f"{self.folder}: sensor.{key} applies to the synthetic detector; add "
+                                  "sensor.model = 'synthetic' (--detector synthetic) to replay the ground truth through it")
         obs_mode = overrides.get("env", {}).get("obs_mode")
         if obs_mode == "frame+detections" and not self.has_images:
             raise scn.ConfigError(f"{self.folder}: env.obs_mode = 'frame+detections', but the sequence has no "
@@ -128,7 +144,8 @@ class Recording:
         i = self.info
         raw = {"name": "Replay", "description": f"the recorded sequence {i.name} ({self.folder})",
                "render": {"width": i.width, "height": i.height, "background": "flat"},
-               "sensor": {"max_detections": max(1, self.max_detections)},
+               "sensor": {"model": "recorded", "max_detections": max(1, self.max_detections)} if model == "recorded"
+               else {},
                "env": {"max_steps": i.length, "obs_mode": "frame+detections" if self.has_images else "detections"}}
         return scn.from_mapping(scn.merge(raw, overrides), str(self.folder))
 

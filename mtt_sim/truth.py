@@ -43,6 +43,28 @@ def clip_boxes(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     return corners
 
 
+def occlusion_visibility(boxes: np.ndarray, width: int, height: int, grid: tuple[int, int] = (8, 16)) -> np.ndarray:
+    """Visible fraction of each box x, y, w, h of people on a ground plane: a box whose bottom edge is lower stands
+    nearer and hides what it covers, and the image border hides what lies outside. Measured on a grid of points (8
+    across, 16 down) in each box: the share that lies in the image and that no nearer box covers."""
+    n = len(boxes)
+    if not n:
+        return np.zeros(0)
+    u = (np.arange(grid[0]) + 0.5) / grid[0]
+    v = (np.arange(grid[1]) + 0.5) / grid[1]
+    px = (boxes[:, 0, None] + boxes[:, 2, None] * u).repeat(grid[1], axis=1)  # (n, points)
+    py = np.tile(boxes[:, 1, None] + boxes[:, 3, None] * v, grid[0])
+    bottom = boxes[:, 1] + boxes[:, 3]
+    seen = (px >= 0) & (px < width) & (py >= 0) & (py < height)
+    for i, j in zip(*overlapping_pairs(boxes)):  # each pair once: the nearer box hides part of the farther one
+        near, far = (i, j) if bottom[i] > bottom[j] else (j, i)
+        if bottom[near] == bottom[far]:
+            continue
+        b = boxes[near]
+        seen[far] &= ~((px[far] >= b[0]) & (px[far] < b[0] + b[2]) & (py[far] >= b[1]) & (py[far] < b[1] + b[3]))
+    return seen.mean(axis=1)
+
+
 def overlapping_pairs(boxes: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Index pairs (i, j), i != j, each pair once, of boxes x, y, w, h that intersect or come within `margin`.
 

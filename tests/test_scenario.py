@@ -25,7 +25,7 @@ def test_unknown_scenario_lists_the_available_ones():
 
 @pytest.mark.parametrize("overrides, pattern", [
     ({"sensor.pd": 1.5}, r"sensor\.pd = 1\.5: out of range; allowed: 0\.0 <= value <= 1\.0"),
-    ({"sensor.bogus": 1}, r"unknown key sensor\.bogus; allowed keys: model, preset, pd"),
+    ({"sensor.bogus": 1}, r"unknown key sensor\.bogus; allowed keys: model, preset, memory, pd"),
     ({"render.width": "wide"}, r"render\.width = 'wide': expected an integer"),
     ({"render.camera": "drone"}, r"render\.camera = 'drone': allowed values: 'static', 'pan', 'follow', 'shake'"),
     ({"world.walls": 1}, r"world\.walls = 1: expected true or false"),

@@ -7,8 +7,10 @@ from hypothesis import strategies as st
 from helpers import placed, still, tiny
 from mtt_sim import sensor as sensor_mod
 from mtt_sim.scenario import SensorConfig, load
-from mtt_sim.sensor import CLUTTER, components, detection_probability
+from mtt_sim.sensor import CLUTTER, components, detection_probabilities
 from mtt_sim.env import TrackingEnv
+from mtt_sim.metrics import box_iou
+from mtt_sim.truth import Truth
 
 
 def test_ideal_detector_returns_exactly_the_visible_boxes():
@@ -72,11 +74,19 @@ def test_confidences_separate_true_from_false_detections_on_average():
     assert ((d.rows[:, 4] >= 0) & (d.rows[:, 4] <= 1)).all()
 
 
-def test_detection_probability_rises_with_visibility():
-    cfg = SensorConfig(pd=0.9, min_visibility=0.2)
-    p = detection_probability(np.linspace(0, 1, 101), cfg)
-    assert p[-1] == np.float64(0.9) and (p[:21] == 0).all() and (np.diff(p[20:]) > 0).all()
-    assert (detection_probability(np.array([0.3, 1.0]), SensorConfig(pd=1.0, min_visibility=0.2)) == 1).all()
+def test_detection_probability_is_logistic_in_visibility_and_height_and_a_chain_around_it():
+    cfg = SensorConfig(pd=0.9, miss_corr=0.5, min_visibility=0.2, visibility_slope=4.0, height_slope=1.0,
+                       reference_height=100.0)
+    v = np.linspace(0, 1, 101)
+    p, after_hit, after_miss = detection_probabilities(v, np.full(101, 100.0), cfg)
+    np.testing.assert_allclose([p[-1], after_hit[-1], after_miss[-1]], [0.9, 0.95, 0.45])
+    np.testing.assert_allclose(after_miss / (1 - after_hit + after_miss), p)  # the chain's long-run share is p
+    assert (p[:21] == 0).all() and (np.diff(p[20:]) > 0).all() and (after_miss < p)[21:].all()
+    np.testing.assert_allclose(p[60], 1 / (1 + np.exp(-(np.log(9) - 4 * 0.4))))
+    sizes, _, _ = detection_probabilities(np.ones(3), np.array([50.0, 100.0, 400.0]), cfg)
+    np.testing.assert_allclose(sizes, 1 / (1 + np.exp(-(np.log(9) - np.array([1.0, 0.0, 0.0])))))  # a knee at 100 px
+    certain = detection_probabilities(np.array([0.3, 1.0]), np.full(2, 5.0), SensorConfig(pd=1.0))
+    assert (certain[0] == 1).all() and (certain[1] == 1).all()
 
 
 def test_foreground_detector_finds_a_lone_target():
@@ -117,3 +127,69 @@ def test_components_match_a_union_find(n, edges):
 
 def test_load_uses_shipped_preset_values():
     assert load("dense").sensor.pd == 0.93
+
+
+def frames_of(sensor_keys, n_frames, boxes=((80.0, 20.0, 20.0, 40.0),), seed=0, visibility=None):
+    """Detections of a SyntheticSensor looking at fixed targets (ids 1, 2, ...) for n_frames frames."""
+    boxes = np.asarray(boxes, float)
+    n = len(boxes)
+    truth = Truth(ids=np.arange(1, n + 1), boxes=boxes, visibility=np.ones(n) if visibility is None else visibility,
+                  visible_boxes=boxes, depth=np.zeros(n), labels=np.arange(1, n + 1), pieces=np.zeros((0, 5)))
+    s = sensor_mod.SyntheticSensor(tiny(sensor={"box_noise": 0.0, **sensor_keys}), np.random.default_rng(seed))
+    return [s.detect(truth) for _ in range(n_frames)]
+
+
+def miss_statistics(frames):
+    hit = np.array([(d.sources == 1).any() for d in frames])
+    after_miss = ~hit[:-1]
+    return 1 - hit.mean(), (~hit[1:][after_miss]).mean()
+
+
+def test_misses_persist_with_memory_and_not_without_at_the_same_rate():
+    keys = {"pd": 0.7, "miss_corr": 0.6, "reference_height": 40.0}
+    p_miss, p_miss_after_miss = miss_statistics(frames_of(keys, 20000))
+    assert abs(p_miss - 0.3) < 0.02 and abs(p_miss_after_miss - (1 - 0.7 * 0.4)) < 0.02  # 0.72
+    p_miss, p_miss_after_miss = miss_statistics(frames_of({**keys, "memory": False}, 20000))
+    assert abs(p_miss - 0.3) < 0.02 and abs(p_miss_after_miss - 0.3) < 0.02
+
+
+def test_false_positive_sites_repeat_their_box_for_their_life():
+    keys = {"pd": 0.0, "site_rate": 0.1, "site_life": 20.0, "site_near": 0.0}
+    frames = frames_of(keys, 4000)
+    counts = np.array([len(d.rows) for d in frames])
+    assert abs(counts.mean() - 2.0) < 0.25  # rate x life sites alive on average
+    boxes = [tuple(r) for d in frames for r in d.rows[:, :4].tolist()]
+    distinct = len(set(boxes))
+    assert abs(len(boxes) / distinct - 20.0) < 2.5  # each site's box fires on about 20 frames
+    frames = frames_of({**keys, "memory": False}, 4000)
+    boxes = [tuple(r) for d in frames for r in d.rows[:, :4].tolist()]
+    assert abs(len(boxes) / 4000 - 2.0) < 0.25 and len(set(boxes)) == len(boxes)
+
+
+def test_sites_beside_a_target_overlap_it_loosely_and_move_with_it():
+    keys = {"pd": 0.0, "site_rate": 0.5, "site_life": 5.0, "site_near": 1.0, "box_outlier_noise": 0.3}
+    frames = frames_of(keys, 400, boxes=((80.0, 20.0, 20.0, 40.0),))
+    fp = np.concatenate([d.rows[:, :4] for d in frames])
+    iou = box_iou(np.array([[80.0, 20.0, 20.0, 40.0]]), fp.astype(float))[0]
+    inside = (fp[:, 0] > 0) & (fp[:, 1] > 0) & (fp[:, 0] + fp[:, 2] < 200) & (fp[:, 1] + fp[:, 3] < 100)
+    assert len(fp) > 500 and (iou[inside] >= 0.1 - 1e-6).all() and (iou[inside] < 0.5).all()
+
+
+def test_box_drift_is_an_ar1_process_per_target():
+    keys = {"pd": 1.0, "box_drift": 0.05, "box_drift_corr": 0.9}
+    unit = np.sqrt(20.0 * 40.0)  # offsets are in units of sqrt(w h)
+    dx = np.array([(d.rows[0, 0] + d.rows[0, 2] / 2 - 90.0) / unit for d in frames_of(keys, 5000)])
+    assert abs(dx.std() - 0.05) < 0.01 and abs(np.corrcoef(dx[1:], dx[:-1])[0, 1] - 0.9) < 0.05
+    dx = np.array([(d.rows[0, 0] + d.rows[0, 2] / 2 - 90.0) / unit for d in frames_of({**keys, "memory": False}, 5000)])
+    assert abs(dx.std() - 0.05) < 0.01 and abs(np.corrcoef(dx[1:], dx[:-1])[0, 1]) < 0.05
+
+
+def test_confidences_can_be_raw_scores_and_fall_with_visibility():
+    keys = {"pd": 1.0, "conf_true": 0.8, "conf_visibility": 2.0, "conf_spread": 20.0, "conf_offset": -1.0,
+            "conf_scale": 3.0, "min_visibility": 0.0}
+    boxes = ((20.0, 20.0, 20.0, 40.0), (120.0, 20.0, 20.0, 40.0))
+    frames = frames_of(keys, 3000, boxes=boxes, visibility=np.array([1.0, 0.5]))
+    conf = {i: np.array([c for d in frames for c, s in zip(d.rows[:, 4], d.sources) if s == i]) for i in (1, 2)}
+    full, half = (1 / (1 + np.exp(-(np.log(4) - 2 * v))) for v in (0.0, 0.5))
+    assert abs(conf[1].mean() - (-1 + 3 * full)) < 0.02 and abs(conf[2].mean() - (-1 + 3 * half)) < 0.02
+    assert conf[1].min() >= -1 and conf[1].max() <= 2

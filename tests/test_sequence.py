@@ -73,8 +73,14 @@ def test_a_detections_only_folder_has_no_frames_and_says_so(tmp_path):
         TrackingEnv(folder, obs_mode="frame+detections")
     with pytest.raises(mtt_sim.ConfigError, match="no img1/ folder"):
         experiment.run_episode(str(folder), "pf")
-    with pytest.raises(mtt_sim.ConfigError, match="takes only env.\\* and scoring.\\* overrides, not sensor"):
+    with pytest.raises(mtt_sim.ConfigError, match="takes only env.\\*, scoring.\\* and sensor.\\* overrides, not world"):
+        TrackingEnv(folder, config={"world.walls": True})
+    with pytest.raises(mtt_sim.ConfigError, match="sensor.pd applies to the synthetic detector; add sensor.model"):
         TrackingEnv(folder, config={"sensor.pd": 0.5})
+    with pytest.raises(mtt_sim.ConfigError, match="'foreground' needs frames the simulator rendered"):
+        TrackingEnv(folder, config={"sensor.model": "foreground"})
+    with pytest.raises(mtt_sim.ConfigError, match="'recorded' replays a sequence folder"):
+        TrackingEnv("crossing", config={"sensor.model": "recorded"})
 
 
 def test_without_ground_truth_the_env_runs_unscored_and_says_so(tmp_path):

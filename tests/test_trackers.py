@@ -65,7 +65,7 @@ def test_known_tracks_through_a_crossing_a_miss_a_false_alarm_a_birth_and_a_deat
     assert reported["A"] >= 20 and reported["B"] >= 14 and reported["C"] >= 14
 
 
-EASY = {"sensor": {"pd": 0.99, "clutter_rate": 0.0, "merge_prob": 0.0, "fragment_prob": 0.0, "box_noise": 0.02,
+EASY = {"sensor": {"pd": 0.99, "miss_corr": 0.0, "clutter_rate": 0.0, "merge_prob": 0.0, "fragment_prob": 0.0, "box_noise": 0.02,
                    "min_visibility": 0.0}, "groups.0.count": 8, "env.max_steps": 150}
 
 

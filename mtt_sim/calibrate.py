@@ -1,0 +1,417 @@
+"""Fit the synthetic detector to real detections, and measure how a detector fails: `mtt-sim calibrate`.
+
+Each frame's detections are associated with its people (the sequence's ground truth, every person row, scored or
+not: a real detector fires on them all) by the Hungarian method, first at IoU >= 0.5 (true detections), then the
+rest at IoU >= 0.3 (outliers: the person was detected, with a poor box); what is left is a false positive.
+The fit, per part of the model (`mtt_sim.sensor`):
+- misses: maximum likelihood (L-BFGS) of the two-state chain of detections with logistic covariates over every
+  person-frame (a person seen in the previous frame continues its chain, a new one starts at its long-run P);
+  outliers: their share of the detections after a true one, and after anything else;
+- boxes: matched moments of the true detections' residuals (offset in box sizes, log size ratio): mean log size is
+  box_scale; variance, lag-1 and lag-2 covariance of a person's residuals give the AR(1) drift and the per-frame
+  noise; outliers' share and spread;
+- false positives: linked frame to frame (IoU >= 0.5) into runs; the number of runs per frame, their mean length
+  and the share of one-frame runs give fresh clutter, the site birth rate and the site life (matched moments);
+  the share of runs that overlap a person (IoU >= 0.1) is site_near;
+- merges and fragments: counted (a false positive covering two overlapping people; several inside a missed one);
+- confidences: offset and scale from their range; the mean of true detections' confidences by non-linear least
+  squares in visibility and height; Beta concentrations by moments.
+`statistics` measures the same things on any detections of a ground truth, so the twin is checked against the data
+with one function.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from scipy.optimize import least_squares, linear_sum_assignment, minimize
+from scipy.special import expit, logit
+
+from . import scenario as scn
+from .metrics import box_iou
+from .sensor import SyntheticSensor
+from .sequence import Recording
+from .truth import Truth, overlapping_pairs
+
+MATCH_IOU = 0.5     # a true detection
+OUTLIER_IOU = 0.3   # a detection of the person with a poor box
+NEAR_IOU = 0.1      # a false positive beside a person
+RUN_BINS = (1, 2, 3, 6, 11, 31)  # run-length histogram bins: 1, 2, 3-5, 6-10, 11-30, 31+
+VISIBILITY_BINS = (0.0, 0.25, 0.5, 0.75, 1.0001)
+HEIGHT_BINS = (0, 50, 100, 200, 1e9)
+
+
+@dataclass(frozen=True)
+class Associated:
+    """Detections associated with the people of a sequence: one row per person-frame and one per detection."""
+
+    frame: np.ndarray       # person-frames: frame index
+    ident: np.ndarray       # person id
+    visibility: np.ndarray
+    height: np.ndarray      # box height, px
+    hit: np.ndarray         # detected at IoU >= MATCH_IOU
+    detected: np.ndarray    # detected at all (hit, or an outlier at IoU >= OUTLIER_IOU)
+    iou: np.ndarray         # IoU of its detection (nan if none)
+    box: np.ndarray         # (n, 4) its box
+    match: np.ndarray       # (n, 4) its detection's box (nan if none)
+    conf: np.ndarray        # confidence of its detection (nan if none)
+    det_frame: np.ndarray   # detections: frame index
+    det_box: np.ndarray     # (m, 4)
+    det_conf: np.ndarray
+    det_kind: np.ndarray    # 0 true, 1 outlier, 2 false positive
+    det_near: np.ndarray    # overlaps a person with IoU >= NEAR_IOU
+    merged: int             # false positives that cover two overlapping people
+    pairs: int              # pairs of people whose boxes overlap (person-frames)
+    fragmented: int         # missed person-frames with two or more false positives inside the box
+    frames: int
+
+
+def _match(similarity: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """Hungarian matching maximising the summed similarity over pairs at or above the threshold."""
+    if not similarity.size:
+        return np.zeros(0, int), np.zeros(0, int)
+    s = np.where(similarity >= threshold, similarity, 0.0)
+    r, c = linear_sum_assignment(-s)
+    ok = s[r, c] > 0
+    return r[ok], c[ok]
+
+
+def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    lo = np.minimum(a[:, :2], b[:, :2])
+    hi = np.maximum(a[:, :2] + a[:, 2:], b[:, :2] + b[:, 2:])
+    return np.concatenate([lo, hi - lo], axis=1)
+
+
+def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Associated:
+    """Associate each frame's detections (n, 5) with its people (see the module docstring)."""
+    people, dets = [], []
+    merged = pairs = fragmented = 0
+    for k, (t, d) in enumerate(zip(truths, detections)):
+        d = np.asarray(d, float)
+        sim = box_iou(t.boxes, d[:, :4]) if len(t) and len(d) else np.zeros((len(t), len(d)))
+        r1, c1 = _match(sim, MATCH_IOU)
+        free_t, free_d = np.setdiff1d(np.arange(len(t)), r1), np.setdiff1d(np.arange(len(d)), c1)
+        r2, c2 = _match(sim[np.ix_(free_t, free_d)], OUTLIER_IOU)
+        r2, c2 = free_t[r2], free_d[c2]
+        det_of = np.full(len(t), -1)
+        det_of[r1], det_of[r2] = c1, c2
+        kind = np.full(len(d), 2)
+        kind[c1], kind[c2] = 0, 1
+        boxes, j = t.boxes.astype(float), np.maximum(det_of, 0)
+        found = det_of >= 0
+        match = np.full((len(t), 5), np.nan)
+        if len(d):
+            match[found] = d[j[found], :5]
+        people.append(np.c_[np.full(len(t), k), t.ids, t.visibility, boxes[:, 3], np.isin(np.arange(len(t)), r1),
+                            found, np.where(found, sim[np.arange(len(t)), j] if len(d) else 0, np.nan), boxes, match])
+        near = sim.max(axis=0) >= NEAR_IOU if len(t) else np.zeros(len(d), bool)
+        dets.append(np.c_[np.full(len(d), k), d[:, :5], kind, near])
+        if len(t) > 1:
+            i, jj = overlapping_pairs(boxes)
+            pairs += len(i)
+            false = d[kind == 2, :4]
+            if len(i) and len(false):
+                cover = box_iou(_union(boxes[i], boxes[jj]), false) >= MATCH_IOU
+                alone = (sim[i][:, kind == 2] < MATCH_IOU) & (sim[jj][:, kind == 2] < MATCH_IOU)
+                merged += int((cover & alone).any(axis=1).sum())
+        if len(d) and (~found).any():
+            inside = _inside(boxes[~found], d[kind == 2, :4])
+            fragmented += int((inside.sum(axis=1) >= 2).sum())
+    p = np.concatenate(people) if people else np.zeros((0, 16))
+    q = np.concatenate(dets) if dets else np.zeros((0, 8))
+    return Associated(frame=p[:, 0].astype(int), ident=p[:, 1].astype(np.int64), visibility=p[:, 2], height=p[:, 3],
+                      hit=p[:, 4] > 0, detected=p[:, 5] > 0, iou=p[:, 6], box=p[:, 7:11], match=p[:, 11:15], conf=p[:, 15],
+                      det_frame=q[:, 0].astype(int), det_box=q[:, 1:5], det_conf=q[:, 5], det_kind=q[:, 6].astype(int),
+                      det_near=q[:, 7] > 0, merged=merged, pairs=pairs, fragmented=fragmented, frames=len(truths))
+
+
+def _inside(boxes: np.ndarray, dets: np.ndarray) -> np.ndarray:
+    """(people, detections): whether at least 80 % of a detection's area lies in a person's box."""
+    lo = np.maximum(boxes[:, None, :2], dets[None, :, :2])
+    hi = np.minimum(boxes[:, None, :2] + boxes[:, None, 2:], dets[None, :, :2] + dets[None, :, 2:])
+    inter = np.prod(np.clip(hi - lo, 0, None), axis=2)
+    return inter >= 0.8 * np.prod(dets[:, 2:], axis=1)[None]
+
+
+# ------------------------------------------------------------------ sequences of person-frames and of false positives
+
+def _chains(a: Associated) -> tuple[np.ndarray, np.ndarray]:
+    """Person-frames sorted by person and frame, and whether each continues the previous row (same person, next frame)."""
+    order = np.lexsort((a.frame, a.ident))
+    cont = np.zeros(len(order), bool)
+    cont[1:] = (a.ident[order][1:] == a.ident[order][:-1]) & (a.frame[order][1:] == a.frame[order][:-1] + 1)
+    return order, cont
+
+
+def run_lengths(values: np.ndarray, cont: np.ndarray) -> np.ndarray:
+    """Lengths of the runs of True in `values`, a run broken where `cont` is False."""
+    start = values & ~np.r_[False, values[:-1] & cont[1:]] if len(values) else values
+    run = np.cumsum(start) - 1
+    return np.bincount(run[values], minlength=int(start.sum())) if values.any() else np.zeros(0, int)
+
+
+def false_runs(a: Associated, kinds: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """False positives of these kinds linked frame to frame (IoU >= 0.5, Hungarian): (run lengths, whether each run
+    starts beside a person)."""
+    keep = np.isin(a.det_kind, kinds)
+    frames, boxes, near = a.det_frame[keep], a.det_box[keep], a.det_near[keep]
+    bounds = np.searchsorted(frames, np.arange(a.frames + 1))
+    lengths, starts_near = [], []
+    alive_box, alive_len, alive_near = np.zeros((0, 4)), np.zeros(0, int), np.zeros(0, bool)
+    for k in range(a.frames + 1):
+        b = boxes[bounds[k]: bounds[k + 1]] if k < a.frames else np.zeros((0, 4))
+        nb = near[bounds[k]: bounds[k + 1]] if k < a.frames else np.zeros(0, bool)
+        r, c = _match(box_iou(alive_box, b) if len(alive_box) and len(b) else np.zeros((len(alive_box), len(b))),
+                      MATCH_IOU)
+        ended = np.setdiff1d(np.arange(len(alive_box)), r)
+        lengths += alive_len[ended].tolist()
+        starts_near += alive_near[ended].tolist()
+        new = np.setdiff1d(np.arange(len(b)), c)
+        alive_box = np.concatenate([b[c], b[new]])
+        alive_len = np.concatenate([alive_len[r] + 1, np.ones(len(new), int)])
+        alive_near = np.concatenate([alive_near[r], nb[new]])
+    return np.array(lengths, int), np.array(starts_near, bool)
+
+
+# ------------------------------------------------------------------ the fit
+
+def fit(a: Associated) -> dict:
+    """The synthetic detector's keys fitted to associated detections (see the module docstring)."""
+    if not a.detected.any():
+        raise ValueError("no detection of a person to fit to (does the sequence have det/det.txt and gt/gt.txt?)")
+    out = {"model": "synthetic", "memory": True}
+    out.update(_fit_misses(a))
+    out.update(_fit_boxes(a))
+    out.update(_fit_false_positives(a))
+    out.update(_fit_confidences(a, out["reference_height"]))
+    out["merge_prob"] = a.merged / a.pairs if a.pairs else 0.0
+    out["fragment_prob"] = a.fragmented / len(a.frame)
+    return {k: (round(float(v), 4) if isinstance(v, (float, np.floating)) else v) for k, v in out.items()}
+
+
+def _fit_misses(a: Associated) -> dict:
+    """Maximum likelihood (L-BFGS) of the chain of detections (true or outlier): P = expit(b0 + b1 (v - 1) + b2
+    min(0, log2(h / ref))) with lag-1 correlation miss_corr, over person-frames above min_visibility (the 1st percentile
+    of the detected ones' visibility); the knee ref is the best of the height deciles. Outliers: their share of the
+    detections after a true one, and after an outlier, a miss or nothing."""
+    min_visibility = max(0.0, float(np.quantile(a.visibility[a.detected], 0.01)) - 0.01)
+    order, cont = _chains(a)
+    use = a.visibility[order] > min_visibility
+    y = a.detected[order][use]
+    prev = np.where(cont, np.r_[False, a.detected[order][:-1]], -1)[use]  # -1: the first frame of a person's chain
+    v, h = a.visibility[order][use] - 1, a.height[order][use]
+
+    def nll(theta, x):
+        p = expit(x @ theta[:3])
+        lam = expit(theta[3])
+        q = np.where(prev == 1, p + (1 - p) * lam, np.where(prev == 0, p * (1 - lam), p))
+        q = np.clip(q, 1e-12, 1 - 1e-12)
+        return -np.sum(np.where(y, np.log(q), np.log1p(-q)))
+
+    best = None
+    start = np.array([logit(np.clip(y.mean(), 0.01, 0.99)), 2.0, 1.0, 0.0])
+    for knee in np.unique(np.round(np.quantile(h, np.linspace(0.1, 0.9, 9)))):
+        x = np.c_[np.ones(len(y)), v, np.minimum(np.log2(np.maximum(h, 1e-3) / knee), 0)]
+        res = minimize(nll, start, args=(x,), method="L-BFGS-B")
+        if best is None or res.fun < best[0]:
+            best = (res.fun, res.x, knee)
+    _, theta, knee = best
+    detected, poor = a.detected[order], (a.detected & ~a.hit)[order]
+    after_good = np.r_[False, a.hit[order][:-1]] & cont
+    return {"pd": expit(theta[0]), "miss_corr": min(expit(theta[3]), 0.999),
+            "visibility_slope": float(np.clip(theta[1], 0, 100)), "height_slope": float(np.clip(theta[2], -10, 10)),
+            "reference_height": float(knee), "min_visibility": min_visibility,
+            "box_outlier_prob": float(poor[detected & after_good].mean()) if (detected & after_good).any() else 0.0,
+            "box_outlier_persist": float(poor[detected & ~after_good].mean()) if (detected & ~after_good).any() else 0.0}
+
+
+def _fit_boxes(a: Associated) -> dict:
+    """Moments of the true detections' boxes: scale and aspect from the mean log size ratios; the residuals about
+    the scaled box, in units of its sqrt(w h): their second moments, lag-1 and lag-2 covariances of a person's
+    residuals give the AR(1) drift (pooled over the four coordinates) and the per-frame noise; outliers."""
+    order, cont = _chains(a)
+    hit, box, match = a.hit[order], a.box[order], a.match[order]
+    ratio = np.log(match[hit, 2:] / box[hit, 2:])
+    scale, aspect = np.exp(ratio.mean()), np.exp(np.mean(ratio[:, 0] - ratio[:, 1]))
+    wh = box[:, 2:] * scale * np.array([np.sqrt(aspect), 1 / np.sqrt(aspect)])
+    unit = np.sqrt(np.prod(wh, axis=1))[:, None]
+    e = np.c_[match[:, :2] + match[:, 2:] / 2 - box[:, :2] - box[:, 2:] / 2, match[:, 2:] - wh] / unit
+    centre, size = float(np.mean(e[hit, :2] ** 2)), float(np.mean(e[hit, 2:] ** 2))
+    lag1 = cont[1:] & hit[1:] & hit[:-1]
+    lag2 = cont[2:] & cont[1:-1] & hit[2:] & hit[:-2]
+    c1 = float(np.mean(e[1:][lag1] * e[:-1][lag1])) if lag1.any() else 0.0
+    c2 = float(np.mean(e[2:][lag2] * e[:-2][lag2])) if lag2.any() else 0.0
+    rho, drift = (min(c2 / c1, 0.999), min(c1 ** 2 / c2, centre, size)) if c1 > 0 and c2 > 0 else (0.9, 0.0)
+    outlier = a.detected & ~a.hit
+    spread = a.match[outlier, :4] - a.box[outlier]  # about the true box, as outliers are drawn
+    spread[:, :2] += (spread[:, 2:]) / 2
+    spread /= np.sqrt(np.prod(a.box[outlier, 2:], axis=1))[:, None]
+    return {"box_noise": math.sqrt(centre - drift), "box_size_noise": math.sqrt(size - drift),
+            "box_drift": math.sqrt(drift), "box_drift_corr": rho, "box_scale": float(np.clip(scale, 0.5, 2.0)),
+            "box_aspect": float(np.clip(aspect, 0.25, 4.0)), "box_outlier_noise": float(np.clip(np.sqrt(np.mean(spread ** 2)), 0.01, 2)) if outlier.any() else 0.3}
+
+
+def _fit_false_positives(a: Associated) -> dict:
+    """Fresh clutter c, sites born at s per frame living L frames (geometric): runs per frame R = c + s, mean run
+    m = (c + s L) / R, share of one-frame runs f1 = (c + s / L) / R, solved for c, s, L."""
+    lengths, near = false_runs(a, (2,))
+    if not len(lengths):
+        return {"clutter_rate": 0.0, "site_rate": 0.0, "site_life": 10.0, "site_near": 0.5}
+    rate, m, f1 = len(lengths) / a.frames, lengths.mean(), float(np.mean(lengths == 1))
+    life = (m - 1) / (1 - f1) if f1 < 1 else 1.0
+    if life <= 1:
+        clutter, sites, life = rate, 0.0, 10.0
+    else:
+        sites = rate * (m - 1) / (life - 1)
+        clutter = rate - sites
+        if clutter < 0:
+            clutter, sites, life = 0.0, rate, m
+    lasting = lengths > 1
+    return {"clutter_rate": clutter, "site_rate": sites, "site_life": max(life, 1.0),
+            "site_near": float(near[lasting].mean() if lasting.any() else near.mean())}
+
+
+def _fit_confidences(a: Associated, reference: float) -> dict:
+    """Offset and scale from the range; true mean by least squares in visibility and height; Beta concentrations."""
+    lo, hi = float(a.det_conf.min()), float(a.det_conf.max())
+    pad = 0.01 * max(hi - lo, 1e-3)
+    offset, scale = lo - pad, (hi - lo) + 2 * pad
+    true = a.detected
+    y = (a.conf[true] - offset) / scale
+    x = np.c_[a.visibility[true] - 1, np.log2(np.maximum(a.height[true], 1e-3) / reference)]
+    start = np.array([logit(np.clip(y.mean(), 0.02, 0.98)), 0.0, 0.0])
+    b = least_squares(lambda b: expit(b[0] + x @ b[1:]) - y, start).x
+    mean = expit(b[0] + x @ b[1:])
+    spread = np.sum(mean * (1 - mean)) / max(np.sum((y - mean) ** 2), 1e-12) - 1
+    f = (a.det_conf[a.det_kind == 2] - offset) / scale
+    false_mean = float(f.mean()) if len(f) else 0.35
+    false_spread = false_mean * (1 - false_mean) / max(float(f.var()), 1e-12) - 1 if len(f) > 1 else 0.0
+    return {"conf_true": float(np.clip(expit(b[0]), 0.01, 0.99)), "conf_visibility": float(np.clip(b[1], 0, 100)),
+            "conf_height": float(np.clip(b[2], -10, 10)), "conf_spread": float(np.clip(spread, 0.5, 1e4)),
+            "conf_false": float(np.clip(false_mean, 0.01, 0.99)),
+            "conf_false_spread": float(np.clip(false_spread, 0.5, 1e4)), "conf_offset": offset, "conf_scale": scale}
+
+
+# ------------------------------------------------------------------ statistics, on the data and on the twin
+
+def statistics(a: Associated) -> dict:
+    """How a detector fails on a ground truth, at IoU >= 0.5: misses and their runs, recall by visibility and height,
+    false positives and their persistence, box overlap, confidences."""
+    order, cont = _chains(a)
+    miss = ~a.hit[order]
+    after_miss = cont[1:] & miss[:-1]
+    misses, hits = run_lengths(miss, cont), run_lengths(~miss, cont)
+    lengths, _ = false_runs(a, (1, 2))
+    true, false = a.hit, a.det_kind != 0
+    out = {"P(miss)": miss.mean(), "P(miss | miss)": miss[1:][after_miss].mean() if after_miss.any() else math.nan,
+           "mean miss run": misses.mean() if len(misses) else math.nan,
+           "mean hit run": hits.mean() if len(hits) else math.nan}
+    for name, runs in (("miss runs", misses), ("hit runs", hits)):
+        counts = np.histogram(runs, bins=(*RUN_BINS, np.inf))[0]
+        for lo, hi, c in zip(RUN_BINS, (*RUN_BINS[1:], None), counts):
+            label = f"{lo}" if hi == lo + 1 else (f"{lo}-{hi - 1}" if hi else f"{lo}+")
+            out[f"{name} {label} (share)"] = c / max(len(runs), 1)
+    for name, values, bins in (("visibility", a.visibility, VISIBILITY_BINS), ("height px", a.height, HEIGHT_BINS)):
+        which = np.digitize(values, bins[1:-1])
+        for b in range(len(bins) - 1):
+            label = f"{bins[b]:g}-{bins[b + 1]:g}" if b < len(bins) - 2 else f"{bins[b]:g}+"
+            sel = which == b
+            out[f"recall, {name} {label}"] = a.hit[sel].mean() if sel.any() else math.nan
+    out.update({"false positives per frame": false.sum() / max(a.frames, 1),
+                "mean false-positive run": lengths.mean() if len(lengths) else math.nan,
+                "false positives in runs > 1 (share)": lengths[lengths > 1].sum() / max(lengths.sum(), 1),
+                "false positives beside a person (share)": a.det_near[false].mean() if false.any() else math.nan,
+                "mean IoU of true detections": np.nanmean(a.iou[true]) if true.any() else math.nan,
+                "confidence, true (mean)": np.nanmean(a.conf[true]) if true.any() else math.nan,
+                "confidence, true (std)": np.nanstd(a.conf[true]) if true.any() else math.nan,
+                "confidence, false (mean)": a.det_conf[false].mean() if false.any() else math.nan,
+                "confidence, false (std)": a.det_conf[false].std() if false.any() else math.nan})
+    return {k: float(v) for k, v in out.items()}
+
+
+def people(recording: Recording) -> list[Truth]:
+    """The people of every frame of a recording."""
+    return [recording.truth(k) for k in range(len(recording))]
+
+
+def twin_detections(recording: Recording, sensor: dict, seed: int, truths: list[Truth] | None = None) -> list[np.ndarray]:
+    """What the synthetic detector with these keys reports on the recording's people, frame by frame."""
+    sc = recording.scenario({"sensor": {**sensor, "model": "synthetic"}, "env": {"obs_mode": "detections"}})
+    s = SyntheticSensor(sc, np.random.default_rng(seed))
+    return [s.detect(t).rows.astype(float) for t in (truths or people(recording))]
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A fit and the statistics it was checked with."""
+
+    sensor: dict
+    data: dict
+    twin: dict
+    sources: tuple[str, ...]
+    person_frames: int
+    detections: int
+
+
+def calibrate(folders: Sequence[str | Path], seeds: int = 3) -> Calibration:
+    """Fit the detector on every folder's detections together; the twin's statistics are the mean over `seeds`
+    runs of the fitted detector on the same people."""
+    recs = [_readable(f) for f in folders]
+    truths = [people(r) for r in recs]
+    assoc = [associate(t, [r.detections(k) for k in range(len(r))]) for r, t in zip(recs, truths)]
+    pooled = _pool(assoc)
+    sensor = fit(pooled)
+    twin = [statistics(_pool([associate(t, twin_detections(r, sensor, s, t)) for r, t in zip(recs, truths)]))
+            for s in range(seeds)]
+    return Calibration(sensor, statistics(pooled), {k: float(np.nanmean([t[k] for t in twin])) for k in twin[0]},
+                       tuple(str(f) for f in folders), len(pooled.frame), len(pooled.det_frame))
+
+
+def _readable(folder) -> Recording:
+    rec = Recording(folder)
+    if not rec.scored or not (Path(folder) / "det" / "det.txt").is_file():
+        raise scn.ConfigError(f"{folder}: calibrating needs both gt/gt.txt and det/det.txt")
+    return rec
+
+
+def _pool(parts: Sequence[Associated]) -> Associated:
+    """Several sequences' associations as one (frame numbers offset so that no chain or run crosses sequences)."""
+    if len(parts) == 1:
+        return parts[0]
+    offsets = np.cumsum([0] + [p.frames + 1 for p in parts[:-1]])
+    cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
+    return Associated(**{name: cat(name) for name in ("ident", "visibility", "height", "hit", "detected", "iou",
+                                                      "box", "match", "conf", "det_box", "det_conf", "det_kind", "det_near")},
+                      frame=np.concatenate([p.frame + o for p, o in zip(parts, offsets)]),
+                      det_frame=np.concatenate([p.det_frame + o for p, o in zip(parts, offsets)]),
+                      merged=sum(p.merged for p in parts), pairs=sum(p.pairs for p in parts),
+                      fragmented=sum(p.fragmented for p in parts), frames=int(offsets[-1] + parts[-1].frames))
+
+
+def report(c: Calibration) -> str:
+    """The data's statistics beside the fitted twin's, as a text table."""
+    width = max(map(len, c.data))
+    lines = [f"{'statistic':{width}s}  {'data':>8s}  {'twin':>8s}"]
+    lines += [f"{k:{width}s}  {c.data[k]:8.3f}  {c.twin[k]:8.3f}" for k in c.data]
+    return "\n".join(lines)
+
+
+def to_toml(c: Calibration) -> str:
+    """The fitted [sensor] table, with a header saying what it was fitted to and how."""
+    head = [f"# mtt-sim calibrate: the synthetic detector fitted to {', '.join(Path(s).name for s in c.sources)}",
+            f"# ({c.person_frames} person-frames, {c.detections} detections). Misses: maximum likelihood; boxes, false",
+            "# positives and confidences: matched moments (see mtt_sim/calibrate.py).", "[sensor]"]
+    body = [f"{k} = {_toml(v)}" for k, v in c.sensor.items()]
+    return "\n".join(head + body) + "\n"
+
+
+def _toml(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    return repr(float(value))
