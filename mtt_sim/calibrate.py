@@ -333,16 +333,37 @@ def statistics(a: Associated) -> dict:
     return {k: float(v) for k, v in out.items()}
 
 
-def people(recording: Recording) -> list[Truth]:
-    """The people of every frame of a recording."""
-    return [recording.truth(k) for k in range(len(recording))]
+@dataclass(frozen=True)
+class Source:
+    """One sequence read for calibration: its recording, its people frame by frame and its detections associated."""
+
+    recording: Recording
+    truths: list
+    associated: Associated
 
 
-def twin_detections(recording: Recording, sensor: dict, seed: int, truths: list[Truth] | None = None) -> list[np.ndarray]:
-    """What the synthetic detector with these keys reports on the recording's people, frame by frame."""
-    sc = recording.scenario({"sensor": {**sensor, "model": "synthetic"}, "env": {"obs_mode": "detections"}})
+def read(folder: str | Path) -> Source:
+    """A sequence folder with gt/gt.txt and det/det.txt, associated."""
+    rec = Recording(folder)
+    if not rec.scored or not (Path(folder) / "det" / "det.txt").is_file():
+        raise scn.ConfigError(f"{folder}: calibrating needs both gt/gt.txt and det/det.txt")
+    truths = [rec.truth(k) for k in range(len(rec))]
+    return Source(rec, truths, associate(truths, [rec.detections(k) for k in range(len(rec))]))
+
+
+def twin_detections(source: Source, sensor: dict, seed: int) -> list[np.ndarray]:
+    """What the synthetic detector with these keys reports on the sequence's people, frame by frame."""
+    sc = source.recording.scenario({"sensor": {**sensor, "model": "synthetic"}, "env": {"obs_mode": "detections"}})
     s = SyntheticSensor(sc, np.random.default_rng(seed))
-    return [s.detect(t).rows.astype(float) for t in (truths or people(recording))]
+    return [s.detect(t).rows.astype(float) for t in source.truths]
+
+
+def twin_statistics(sources: Sequence[Source], sensor: dict, seeds: int) -> dict:
+    """`statistics` of the twin's detections on these sequences, the mean over `seeds` runs."""
+    runs = [statistics(pooled([associate(src.truths, twin_detections(src, sensor, seed)) for src in sources]))
+            for seed in range(seeds)]
+    with np.errstate(invalid="ignore"):
+        return {k: float(np.mean([r[k] for r in runs])) for k in runs[0]}
 
 
 @dataclass(frozen=True)
@@ -358,27 +379,16 @@ class Calibration:
 
 
 def calibrate(folders: Sequence[str | Path], seeds: int = 3) -> Calibration:
-    """Fit the detector on every folder's detections together; the twin's statistics are the mean over `seeds`
-    runs of the fitted detector on the same people."""
-    recs = [_readable(f) for f in folders]
-    truths = [people(r) for r in recs]
-    assoc = [associate(t, [r.detections(k) for k in range(len(r))]) for r, t in zip(recs, truths)]
-    pooled = _pool(assoc)
-    sensor = fit(pooled)
-    twin = [statistics(_pool([associate(t, twin_detections(r, sensor, s, t)) for r, t in zip(recs, truths)]))
-            for s in range(seeds)]
-    return Calibration(sensor, statistics(pooled), {k: float(np.nanmean([t[k] for t in twin])) for k in twin[0]},
-                       tuple(str(f) for f in folders), len(pooled.frame), len(pooled.det_frame))
+    """Fit the detector on every folder's detections together, and check it: the twin's statistics are the mean over
+    `seeds` runs of the fitted detector on the same people."""
+    sources = [read(f) for f in folders]
+    together = pooled([src.associated for src in sources])
+    sensor = fit(together)
+    return Calibration(sensor, statistics(together), twin_statistics(sources, sensor, seeds),
+                       tuple(str(f) for f in folders), len(together.frame), len(together.det_frame))
 
 
-def _readable(folder) -> Recording:
-    rec = Recording(folder)
-    if not rec.scored or not (Path(folder) / "det" / "det.txt").is_file():
-        raise scn.ConfigError(f"{folder}: calibrating needs both gt/gt.txt and det/det.txt")
-    return rec
-
-
-def _pool(parts: Sequence[Associated]) -> Associated:
+def pooled(parts: Sequence[Associated]) -> Associated:
     """Several sequences' associations as one (frame numbers offset so that no chain or run crosses sequences)."""
     if len(parts) == 1:
         return parts[0]

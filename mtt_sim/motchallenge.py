@@ -22,20 +22,24 @@ from tqdm import tqdm
 
 from .env import NO_TRACKS, TrackingEnv
 from .metrics import EpisodeMetrics
+from .scenario import is_sequence
 from .sequence import Recording, by_frame, check_frames, read_rows
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
            config: Mapping | None = None, progress: bool = False) -> dict:
     """Run `scenario` without a tracker and write its frames, ground truth and detections as a sequence. Frames an
-    earlier, longer export left in `out` are removed."""
+    earlier, longer export left in `out` are removed. A recorded sequence (with `sensor.model = "synthetic"`: its
+    twin) keeps its own gt.txt, and frames only where it has images."""
     out = Path(out)
-    (out / "img1").mkdir(parents=True, exist_ok=True)
-    (out / "gt").mkdir(exist_ok=True)
+    recorded = is_sequence(scenario)
+    env = TrackingEnv(scenario, config=config, obs_mode=None if recorded else "frame+detections")
+    (out / "gt").mkdir(parents=True, exist_ok=True)
     (out / "det").mkdir(exist_ok=True)
     for old in (out / "img1").glob("[0-9]*.jpg"):
         old.unlink()
-    env = TrackingEnv(scenario, config=config, obs_mode="frame+detections")
-    obs, _ = env.reset(seed=seed)
+    obs, first = env.reset(seed=seed)
+    if "frame" in obs:
+        (out / "img1").mkdir(exist_ok=True)
     sc = env.scenario
     limit = steps or sc.env.max_steps
     gt_rows, det_rows = [], []
@@ -43,8 +47,9 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
     frame = 0
     while True:
         frame += 1
-        cv2.imwrite(str(out / "img1" / f"{frame:06d}.jpg"), cv2.cvtColor(obs["frame"], cv2.COLOR_RGB2BGR),
-                    [cv2.IMWRITE_JPEG_QUALITY, 95])
+        if "frame" in obs:
+            cv2.imwrite(str(out / "img1" / f"{frame:06d}.jpg"), cv2.cvtColor(obs["frame"], cv2.COLOR_RGB2BGR),
+                        [cv2.IMWRITE_JPEG_QUALITY, 95])
         t = env.truth
         considered = t.visibility >= sc.scoring.min_visibility
         gt_rows += [(frame, int(i), *b, int(c), 1, float(v))
@@ -56,12 +61,21 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
         if terminated or truncated or frame >= limit:
             break
     bar.close()
-    _write_rows(out / "gt" / "gt.txt", gt_rows)
+    if recorded and env.recording.scored:  # the recording's own ground truth, its lines as written, cut to the frames
+        gt = env.recording.folder / "gt" / "gt.txt"
+        frames = read_rows(gt, 7)[:, 0]
+        lines = [line for line in gt.read_text().splitlines() if line.strip()]
+        gt_rows = [line for line, f in zip(lines, frames) if f <= frame]
+        (out / "gt" / "gt.txt").write_text("".join(f"{line}\n" for line in gt_rows))
+    else:
+        _write_rows(out / "gt" / "gt.txt", gt_rows)
     _write_rows(out / "det" / "det.txt", det_rows)
     info = configparser.ConfigParser()
     info.optionxform = str
-    info["Sequence"] = {"name": f"{sc.name}-seed{seed}", "imDir": "img1", "frameRate": "30", "seqLength": str(frame),
-                        "imWidth": str(sc.render.width), "imHeight": str(sc.render.height), "imExt": ".jpg"}
+    name = f"{env.recording.info.name}-twin" if recorded else sc.name
+    info["Sequence"] = {"name": f"{name}-seed{seed}", "imDir": "img1", "frameRate": f"{first['frame_rate']:g}",
+                        "seqLength": str(frame), "imWidth": str(sc.render.width), "imHeight": str(sc.render.height),
+                        "imExt": ".jpg"}
     with (out / "seqinfo.ini").open("w") as f:
         info.write(f, space_around_delimiters=False)
     return {"frames": frame, "gt_rows": len(gt_rows), "det_rows": len(det_rows), "folder": str(out)}
