@@ -127,6 +127,16 @@ def _tracker_spec(text: str) -> str:
     return specs[0]
 
 
+def _calibration_folder(text: str) -> str:
+    """A real sequence folder with both a ground truth and detections (what calibrate and validate compare)."""
+    folder = Path(text)
+    missing = [f for f in ("gt/gt.txt", "det/det.txt") if not (folder / f).is_file()]
+    if not folder.is_dir() or missing:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a sequence folder with gt/gt.txt and det/det.txt"
+                                         + (f" (no {missing[0]})" if folder.is_dir() else ""))
+    return text
+
+
 def _metrics(text: str) -> list[str]:
     from .metrics import METRICS, PER_TARGET
 
@@ -151,6 +161,21 @@ def parse_overrides(items: list[str]) -> dict:
         if not sep or not key:
             raise UsageError("--config", f"{item!r}: expected key=value, e.g. sensor.clutter_rate=5")
         out[key] = _toml_value(value)
+    return out
+
+
+def _overrides(args) -> dict:
+    """The episode's overrides: --sensor's [sensor] table, then --detector's model, then --config (the last wins)."""
+    out = {}
+    if args.sensor:
+        try:
+            table = scenario.read_sensor(args.sensor)["sensor"]
+        except scenario.ConfigError as err:
+            raise UsageError("--sensor", str(err)) from None
+        out.update({f"sensor.{k}": v for k, v in table.items()})
+    if args.detector:
+        out["sensor.model"] = args.detector
+    out.update(parse_overrides(args.config))
     return out
 
 
@@ -207,7 +232,7 @@ def _require(module: str, argument: str, extra: str) -> None:
 # ------------------------------------------------------------------ commands
 
 def cmd_run(args) -> int:
-    overrides = parse_overrides(args.config)
+    overrides = _overrides(args)
     _loaded([args.scenario], overrides)
     video = _output(args.video, args.force, "--video", (".mp4", ".avi"))
     results = _output(args.results, args.force, "--results", (".txt",))
@@ -231,7 +256,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    overrides = parse_overrides(args.config)
+    overrides = _overrides(args)
     _loaded(args.scenarios, overrides)
     if args.by == "target" and set(args.metric) - {"CentreError", "Coverage"}:
         raise UsageError("--metric", "with --by target: CentreError or Coverage (per-target metrics)")
@@ -244,7 +269,7 @@ def cmd_sweep(args) -> int:
     if not sep or not key or not values:
         raise UsageError("--param", f"{args.param!r}: expected key=v1,v2,..., e.g. sensor.clutter_rate=0,5,10")
     values = [_toml_value(v) for v in values.split(",")]
-    overrides = parse_overrides(args.config)
+    overrides = _overrides(args)
     _loaded([args.scenario], overrides)
     _loaded([args.scenario], overrides, "--param", [{key: v} for v in values])
     if args.plot:
@@ -386,7 +411,7 @@ def cmd_learn_reid(args) -> int:
 
 
 def cmd_export(args) -> int:
-    overrides = parse_overrides(args.config)
+    overrides = _overrides(args)
     _loaded([args.scenario], overrides)
     out = Path(args.out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
@@ -428,8 +453,33 @@ def cmd_check_real(args) -> int:
     return 0 if check_real.check(args.data) else 1
 
 
+def cmd_calibrate(args) -> int:
+    out = _output(args.out, args.force, "--out", (".toml",))
+    from . import calibrate
+
+    fitted = calibrate.calibrate(args.folders, seeds=args.seeds)
+    print(calibrate.report(fitted))
+    out.write_text(calibrate.to_toml(fitted))
+    print(f"\nsensor: {out}" + (" (replaced)" if args.force else "")
+          + f"; replay a sequence through it: mtt-sim run DIR --detector synthetic --sensor {shlex.quote(str(out))}")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    out = _output(args.out, args.force, "--out", (".md",))
+    from . import validate
+
+    result = validate.validate(args.folders, args.trackers or validate.TRACKERS, seeds=args.seeds, workers=args.workers, progress=True)
+    text = validate.markdown(result)
+    print(text)
+    if out:
+        out.write_text(text)
+        print(f"tables: {out}" + (" (replaced)" if args.force else ""))
+    return 1 if result.failed else 0
+
+
 def cmd_config(args) -> int:
-    overrides = parse_overrides(args.config)
+    overrides = _overrides(args)
     if args.scenario:
         _loaded([args.scenario], overrides)
         print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, overrides)), indent=2))
@@ -439,6 +489,16 @@ def cmd_config(args) -> int:
 
 
 # ------------------------------------------------------------------ the parser
+
+def _add_overrides(parser: argparse.ArgumentParser, config_help: str) -> None:
+    """--config, and the detector's two shortcuts: --detector (sensor.model) and --sensor (a [sensor] table file)."""
+    parser.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
+    parser.add_argument("--detector", choices=("synthetic", "foreground", "recorded"),
+                        help="sensor.model: on a sequence folder, 'synthetic' replays its ground truth through the "
+                             "synthetic detector (its twin) instead of det/det.txt ('recorded', the default there)")
+    parser.add_argument("--sensor", metavar="FILE.toml",
+                        help="the [sensor] table of this file (e.g. from mtt-sim calibrate) as overrides; --config wins")
+
 
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="mtt-sim", description="A Gymnasium environment for video multi-target tracking.")
@@ -463,7 +523,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--results", help="write the tracks as a MOTChallenge results file (.txt; an offline method's "
                                        "offline output)")
     run.add_argument("--force", action="store_true", help=force_help)
-    run.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
+    _add_overrides(run, config_help)
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.set_defaults(func=cmd_run)
 
@@ -496,7 +556,7 @@ def build_parser() -> argparse.ArgumentParser:
         g.add_argument("--out", help="write every episode's record as it finishes (.csv or .json)")
         g.add_argument("--results-dir", help="write every episode's tracks as a MOTChallenge results file in this folder")
         g.add_argument("--force", action="store_true", help=force_help)
-        g.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help="overrides for every episode")
+        _add_overrides(g, "overrides for every episode")
         g.set_defaults(func=func)
 
     pf = sub.add_parser("perf", help="speed and memory of the env, the metrics and the trackers, each against a "
@@ -523,7 +583,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--seed", type=_integer(0), default=0, help="episode seed, >= 0 (default 0)")
     ex.add_argument("--steps", type=_integer(1), default=None, help="at most this many frames (default: env.max_steps)")
     ex.add_argument("--force", action="store_true", help="write into a folder that is not empty (its old frames go)")
-    ex.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
+    _add_overrides(ex, config_help)
     ex.set_defaults(func=cmd_export)
 
     ev = sub.add_parser("eval", help="score a MOTChallenge results file against a sequence's ground truth, as TrackEval")
@@ -542,9 +602,30 @@ def build_parser() -> argparse.ArgumentParser:
     cr.add_argument("data", help="the shared data folder (mot15/, reference/, mot17/, mot17_results/)")
     cr.set_defaults(func=cmd_check_real)
 
+    ca = sub.add_parser("calibrate", help="fit the synthetic detector to real detections: print the fit beside the "
+                                          "data and write a [sensor] table")
+    ca.add_argument("folders", nargs="+", type=_calibration_folder, metavar="DIR",
+                    help="sequence folders with gt/gt.txt and det/det.txt (fitted together)")
+    ca.add_argument("--out", required=True, help="the [sensor] table to write (.toml)")
+    ca.add_argument("--seeds", type=_integer(1), default=3, help="twin runs averaged in the check (default 3)")
+    ca.add_argument("--force", action="store_true", help=force_help)
+    ca.set_defaults(func=cmd_calibrate)
+
+    va = sub.add_parser("validate", help="the sim-to-real check: trackers on real detections against the twins "
+                                         "(fitted here, on the other sequences, memoryless)")
+    va.add_argument("folders", nargs="+", type=_calibration_folder, metavar="DIR",
+                    help="sequence folders with gt/gt.txt and det/det.txt (two or more for leave-one-out)")
+    va.add_argument("--trackers", type=_tracker_specs, default=None,
+                    help="tracker specs (default: sort,iou,bytetrack,gnn,gmphd,lmb:reid=false,jpda)")
+    va.add_argument("--seeds", type=_integer(1), default=3, help="twin episodes per sequence and tracker (default 3)")
+    va.add_argument("--workers", type=_integer(1), default=1, help="parallel processes (default 1)")
+    va.add_argument("--out", help="also write the tables to this Markdown file (.md)")
+    va.add_argument("--force", action="store_true", help=force_help)
+    va.set_defaults(func=cmd_validate)
+
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
     cf.add_argument("scenario", nargs="?", type=_scenario, help=scenario_help)
-    cf.add_argument("--config", nargs="*", default=[], metavar="KEY=VALUE", help=config_help)
+    _add_overrides(cf, config_help)
     cf.set_defaults(func=cmd_config)
     return p
 

@@ -109,6 +109,12 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
     tasks = [(sc, spec, seed, {**(config or {}), **c},
               results_path(results_dir, spec, sc, seed if len(seeds) > 1 else None, c) if results_dir else None)
              for c, sc, spec, seed in itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
+    return run_tasks(tasks, workers, progress, backend, address, on_record)
+
+
+def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, backend: str = "local",
+              address: str | None = None, on_record: Callable[[dict], None] | None = None) -> list[dict]:
+    """Episodes (scenario, tracker, seed, config, results file or None) as `run_grid` runs them; records in order."""
     records: list = [None] * len(tasks)
     with tqdm(total=len(tasks), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
         for i, record in _finished(tasks, workers, backend, address):

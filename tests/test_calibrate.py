@@ -1,0 +1,177 @@
+"""Calibration, the digital twin and the sim-to-real check, on hand-made sequence folders."""
+
+import hashlib
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import mtt_sim  # noqa: F401  (registers the env ids)
+from helpers import write_sequence
+from mtt_sim import calibrate, cli, motchallenge, scenario, validate
+from mtt_sim.env import NO_TRACKS
+from mtt_sim.truth import Truth
+
+KNOWN = {"model": "synthetic", "pd": 0.85, "miss_corr": 0.6, "visibility_slope": 3.0, "reference_height": 100.0,
+         "min_visibility": 0.0, "box_noise": 0.03, "box_size_noise": 0.03, "box_drift": 0.05, "box_drift_corr": 0.8,
+         "box_scale": 1.1, "box_outlier_prob": 0.02, "box_outlier_persist": 0.3, "clutter_rate": 1.0,
+         "site_rate": 0.1, "site_life": 15.0, "site_near": 0.3, "merge_prob": 0.0, "fragment_prob": 0.0}
+
+
+def people(frames, count=8, spacing=150.0):
+    """gt rows of still people (MOT17 columns: class 1, visibility 1 for the first half, 0.6 for the rest)."""
+    return [(f, i + 1, 20.0 + spacing * i, 60.0, 0.4 * (100.0 + 15 * i), 100.0 + 15 * i, 1, 1, 1.0 if i < count // 2
+             else 0.6) for i in range(count) for f in range(1, frames + 1)]
+
+
+@pytest.fixture(scope="module")
+def twin(tmp_path_factory):
+    """A sequence whose detections are the synthetic detector's with the KNOWN keys (1,000 frames of 8 people)."""
+    root = tmp_path_factory.mktemp("twin")
+    gt = write_sequence(root / "People", gt=people(1000), size=(1280, 720))
+    motchallenge.export(gt, root / "twin", seed=3, config={"sensor": KNOWN})
+    return root / "twin"
+
+
+def test_calibrate_recovers_the_detector_that_made_the_detections(twin):
+    fitted = calibrate.fit(calibrate.read(twin).associated)
+    tolerance = {"pd": 0.03, "miss_corr": 0.08, "visibility_slope": 0.6, "box_noise": 0.008, "box_size_noise": 0.01,
+                 "box_drift": 0.008, "box_drift_corr": 0.05, "box_scale": 0.02, "box_outlier_prob": 0.015,
+                 "box_outlier_persist": 0.1, "clutter_rate": 0.15, "site_rate": 0.04, "site_life": 4.0}
+    off = {k: (KNOWN[k], fitted[k]) for k, tol in tolerance.items() if abs(fitted[k] - KNOWN[k]) > tol}
+    assert not off, off
+
+
+def test_the_twin_of_a_twin_has_the_data_statistics_and_its_table_loads(twin, tmp_path):
+    c = calibrate.calibrate([twin], seeds=2)
+    for key in ("P(miss)", "P(miss | miss)", "mean miss run", "false positives per frame"):
+        assert c.twin[key] == pytest.approx(c.data[key], rel=0.1), key
+    assert "recall, visibility 0.5-0.75" in calibrate.report(c)
+    (tmp_path / "fitted.toml").write_text(calibrate.to_toml(c))
+    assert scenario.read_sensor(tmp_path / "fitted.toml") == {"sensor": c.sensor}
+    assert scenario.load("crossing", scenario.read_sensor(tmp_path / "fitted.toml")).sensor.pd == c.sensor["pd"]
+
+
+def test_association_counts_true_detections_outliers_and_false_positives():
+    boxes = np.array([[0.0, 0.0, 10.0, 20.0], [50.0, 0.0, 10.0, 20.0]])
+    truth = Truth(ids=np.array([1, 2]), boxes=boxes, visibility=np.ones(2), visible_boxes=boxes, depth=np.zeros(2),
+                  labels=np.array([1, 2]), pieces=np.zeros((0, 5)))
+    dets = np.array([[1.0, 0.0, 10.0, 20.0, 0.9],      # IoU 0.82 with person 1: true
+                     [54.0, 0.0, 10.0, 20.0, 0.5],     # IoU 0.43 with person 2: an outlier
+                     [200.0, 0.0, 10.0, 20.0, 0.1]])   # nowhere near: a false positive
+    a = calibrate.associate([truth], [dets])
+    assert a.hit.tolist() == [True, False] and a.detected.tolist() == [True, True]
+    assert sorted(a.det_kind.tolist()) == [0, 1, 2]
+    assert a.iou[0] == pytest.approx(180 / 220)
+
+
+def test_run_lengths_break_where_the_chain_breaks():
+    values = np.array([1, 1, 0, 1, 1, 1, 0, 1], bool)
+    cont = np.array([0, 1, 1, 1, 0, 1, 1, 1], bool)  # a new person starts at row 4
+    assert calibrate.run_lengths(values, cont).tolist() == [2, 1, 2, 1]
+
+
+def twin_fingerprint(folder, sensor_file, seed):
+    env = gym.make("mtt_sim/Replay-v0", sequence=str(folder), sensor=str(sensor_file))
+    obs, _ = env.reset(seed=seed)
+    digest = hashlib.sha256()
+    for _ in range(30):
+        digest.update(obs["detections"][: int(obs["num_detections"])].tobytes())
+        obs, *_ = env.step(NO_TRACKS)
+    return digest.hexdigest()
+
+
+@pytest.fixture(scope="module")
+def sensor_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sensor") / "fitted.toml"
+    path.write_text("[sensor]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in KNOWN.items()) + "\n")
+    return path
+
+
+def test_the_twin_through_gym_make_is_seeded_and_byte_identical(tmp_path, sensor_file):
+    folder = write_sequence(tmp_path / "Seq", gt=people(30, count=4), size=(640, 480))
+    first, again, other = (twin_fingerprint(folder, sensor_file, s) for s in (5, 5, 6))
+    assert first == again != other
+
+
+def test_the_twin_exports_as_a_sequence_with_the_recording_ground_truth(tmp_path, sensor_file, capsys):
+    folder = write_sequence(tmp_path / "Seq", gt=people(40, count=4), size=(640, 480))
+    assert cli.main(["export", str(folder), "--detector", "synthetic", "--sensor", str(sensor_file), "--seed", "2",
+                     "--out", str(tmp_path / "out")]) == 0
+    out = tmp_path / "out"
+    assert (out / "gt" / "gt.txt").read_text().splitlines() == (folder / "gt" / "gt.txt").read_text().splitlines()
+    det = np.loadtxt(out / "det" / "det.txt", delimiter=",")
+    assert 100 < len(det) < 250 and set(det[:, 0].astype(int)) <= set(range(1, 41))
+    assert "name=Seq-twin-seed2" in (out / "seqinfo.ini").read_text()
+    assert not (out / "img1").exists()
+
+
+def test_calibrate_command_prints_the_fit_beside_the_data_and_writes_a_loadable_table(twin, tmp_path, capsys):
+    out = tmp_path / "fitted.toml"
+    assert cli.main(["calibrate", str(twin), "--out", str(out), "--seeds", "1"]) == 0
+    text = capsys.readouterr().out
+    assert "P(miss | miss)" in text and "mean hit run" in text and "false positives per frame" in text
+    assert scenario.read_sensor(out)["sensor"]["pd"] == pytest.approx(KNOWN["pd"], abs=0.03)
+    assert cli.main(["run", str(twin), "--sensor", str(out), "--steps", "20", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out.splitlines()[-1])["num_frames"] == 20
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["calibrate", "{empty}", "--out", "{tmp}/f.toml"], "is not a sequence folder with gt/gt.txt and det/det.txt"),
+    (["calibrate", "{twin}", "--out", "{tmp}/f.txt"], "must end in .toml"),
+    (["run", "{twin}", "--sensor", "{tmp}/none.toml"], "no such sensor file"),
+    (["run", "{twin}", "--sensor", "{tmp}/bad.toml"], "expected a [sensor] table"),
+    (["run", "{twin}", "--detector", "recorded", "--sensor", "{tmp}/nomodel.toml"],
+     "sensor.pd applies to the synthetic detector"),
+    (["run", "{twin}", "--detector", "foreground"], "needs frames the simulator rendered"),
+    (["validate", "{twin}", "--seeds", "0"], "must be an integer >= 1"),
+])
+def test_calibration_arguments_get_one_line_errors(twin, tmp_path, capsys, argv, message):
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "bad.toml").write_text("[env]\nmax_steps = 3\n")
+    (tmp_path / "nomodel.toml").write_text("[sensor]\npd = 0.5\n")
+    argv = [a.format(empty=tmp_path / "empty", tmp=tmp_path, twin=twin) for a in argv]
+    try:
+        code = cli.main(argv)
+    except SystemExit as done:  # argparse's own checks
+        code = done.code
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.fixture(scope="module")
+def two_sequences(tmp_path_factory):
+    root = tmp_path_factory.mktemp("validate")
+    folders = []
+    for k, count in enumerate((4, 5)):
+        gt = write_sequence(root / f"Gt{k}", gt=people(80, count=count), size=(1280, 720))
+        motchallenge.export(gt, root / f"Seq{k}", seed=k, config={"sensor": KNOWN})
+        folders.append(root / f"Seq{k}")
+    return folders
+
+
+def test_validate_compares_real_and_twin_metrics_for_every_twin(two_sequences):
+    v = validate.validate(two_sequences, ("sort", "iou"), seeds=2)
+    assert set(v.real) == {(s, t) for s in ("Seq0", "Seq1") for t in ("sort", "iou")}
+    assert {k[0] for k in v.twin} == {t.name for t in validate.TWINS} and not v.failed
+    g = validate.gaps(v, "fitted here", "MOTA")
+    assert len(g) == 4
+    by_hand = 100 * (v.twin["fitted here", "Seq1", "iou"]["MOTA"] - v.real["Seq1", "iou"]["MOTA"])
+    assert g[3] == pytest.approx(by_hand)
+    text = validate.markdown(v)
+    assert "| Seq0 | sort |" in text and "memoryless, on the others" in text and "P(miss | miss)" in text
+
+
+def test_kendall_tau_of_identical_rankings_is_one_and_of_reversed_minus_one():
+    real = {("s", t): {"MOTA": m, "IDF1": m, "IDSW": 0.0} for t, m in zip("abc", (0.1, 0.5, 0.3))}
+    twin = {("x", "s", t): {"MOTA": m, "IDF1": -m, "IDSW": 0.0} for t, m in zip("abc", (0.2, 0.6, 0.4))}
+    v = validate.Validation(("s",), tuple("abc"), (validate.TWINS[0],), real, twin, {}, 1, ())
+    assert validate.taus(v, "x", "MOTA").tolist() == [1.0] and validate.taus(v, "x", "IDF1").tolist() == [-1.0]
+
+
+def test_validate_command_writes_its_tables(two_sequences, tmp_path, capsys):
+    out = tmp_path / "check.md"
+    argv = ["validate", *map(str, two_sequences), "--trackers", "sort", "--seeds", "1", "--out", str(out)]
+    assert cli.main(argv) == 0
+    assert "median abs MOTA gap" in out.read_text() and "Goals:" in capsys.readouterr().out
