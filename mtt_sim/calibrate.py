@@ -4,8 +4,9 @@ Each frame's detections are associated with its people (the sequence's ground tr
 not: a real detector fires on them all) by the Hungarian method, first at IoU >= 0.5 (true detections), then the
 rest at IoU >= 0.3 (outliers: the person was detected, with a poor box); what is left is a false positive.
 The fit, per part of the model (`mtt_sim.sensor`):
-- misses: maximum likelihood (L-BFGS) of the two-state chain of detections with logistic covariates over every
-  person-frame (a person seen in the previous frame continues its chain, a new one starts at its long-run P);
+- misses: maximum likelihood (L-BFGS) of the two-state chain of detections with logistic covariates and a
+  per-person random ease of detection over every person-frame (a person seen in the previous frame continues its
+  chain, a new one starts at its long-run P), then the intercept matched to the data's share of detected frames;
   outliers: their share of the detections after a true one, and after anything else;
 - boxes: matched moments of the true detections' residuals (offset in box sizes, log size ratio): mean log size is
   box_scale; variance, lag-1 and lag-2 covariance of a person's residuals give the AR(1) drift and the per-frame
@@ -28,10 +29,11 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
-from scipy.optimize import least_squares, linear_sum_assignment, minimize
-from scipy.special import expit, logit
+from scipy.optimize import brentq, least_squares, linear_sum_assignment, minimize
+from scipy.special import expit, logit, logsumexp
 
 from . import scenario as scn
+from . import scene
 from .metrics import box_iou
 from .sensor import SyntheticSensor
 from .sequence import Recording
@@ -195,34 +197,53 @@ def fit(a: Associated) -> dict:
 
 def _fit_misses(a: Associated) -> dict:
     """Maximum likelihood (L-BFGS) of the chain of detections (true or outlier): P = expit(b0 + b1 (v - 1) + b2
-    min(0, log2(h / ref))) with lag-1 correlation miss_corr, over person-frames above min_visibility (the 1st percentile
-    of the detected ones' visibility); the knee ref is the best of the height deciles. Outliers: their share of the
-    detections after a true one, and after an outlier, a miss or nothing."""
+    min(0, log2(h / ref)) + u) with lag-1 correlation miss_corr, over person-frames above min_visibility (the 1st
+    percentile of the detected ones' visibility); u ~ N(0, pd_spread) is each person's own ease of detection, drawn
+    once per stretch of frames it is present (integrated out by Gauss-Hermite quadrature). The knee ref is the best of
+    the height deciles without u. Outliers: their share of the detections after a true one, and after an outlier, a
+    miss or nothing."""
     min_visibility = max(0.0, float(np.quantile(a.visibility[a.detected], 0.01)) - 0.01)
     order, cont = _chains(a)
     use = a.visibility[order] > min_visibility
     y = a.detected[order][use]
     prev = np.where(cont, np.r_[False, a.detected[order][:-1]], -1)[use]  # -1: the first frame of a person's chain
     v, h = a.visibility[order][use] - 1, a.height[order][use]
+    stretch = (np.cumsum(~cont) - 1)[use]
+    starts = np.flatnonzero(np.r_[True, stretch[1:] != stretch[:-1]])
+    nodes, weights = np.polynomial.hermite_e.hermegauss(15)  # for a standard normal u
+
+    def log_q(theta, x, u):
+        """log P(the observed outcome) per row (and per value of u)."""
+        p = expit((x @ theta[:3])[:, None] + u)
+        lam = expit(theta[3])
+        q = np.where((prev == 1)[:, None], p + (1 - p) * lam, np.where((prev == 0)[:, None], p * (1 - lam), p))
+        q = np.clip(q, 1e-12, 1 - 1e-12)
+        return np.where(y[:, None], np.log(q), np.log1p(-q))
+
+    def nll_fixed(theta, x):
+        return -log_q(theta, x, np.zeros(1)).sum()
 
     def nll(theta, x):
-        p = expit(x @ theta[:3])
-        lam = expit(theta[3])
-        q = np.where(prev == 1, p + (1 - p) * lam, np.where(prev == 0, p * (1 - lam), p))
-        q = np.clip(q, 1e-12, 1 - 1e-12)
-        return -np.sum(np.where(y, np.log(q), np.log1p(-q)))
+        per_stretch = np.add.reduceat(log_q(theta, x, np.exp(theta[4]) * nodes), starts, axis=0)
+        return -logsumexp(per_stretch, b=weights / weights.sum(), axis=1).sum()
 
     best = None
     start = np.array([logit(np.clip(y.mean(), 0.01, 0.99)), 2.0, 1.0, 0.0])
     for knee in np.unique(np.round(np.quantile(h, np.linspace(0.1, 0.9, 9)))):
         x = np.c_[np.ones(len(y)), v, np.minimum(np.log2(np.maximum(h, 1e-3) / knee), 0)]
-        res = minimize(nll, start, args=(x,), method="L-BFGS-B")
+        res = minimize(nll_fixed, start, args=(x,), method="L-BFGS-B")
         if best is None or res.fun < best[0]:
-            best = (res.fun, res.x, knee)
-    _, theta, knee = best
+            best = (res.fun, res.x, knee, x)
+    _, theta, knee, x = best
+    theta = minimize(nll, np.r_[theta, math.log(0.5)], args=(x,), method="L-BFGS-B",
+                     bounds=[(None, None)] * 4 + [(math.log(1e-3), math.log(10.0))]).x
+    # the chain's share of detected frames follows P only on average: match the intercept to the data's share
+    rate = lambda b0: float(np.mean(expit(x[:, 1:] @ theta[1:3] + b0 + np.exp(theta[4]) * nodes[:, None]).T  # noqa
+                                    @ (weights / weights.sum())))
+    theta[0] = brentq(lambda b0: rate(b0) - y.mean(), theta[0] - 10, theta[0] + 10)
     detected, poor = a.detected[order], (a.detected & ~a.hit)[order]
     after_good = np.r_[False, a.hit[order][:-1]] & cont
-    return {"pd": expit(theta[0]), "miss_corr": min(expit(theta[3]), 0.999),
+    return {"pd": expit(theta[0]), "pd_spread": math.exp(theta[4]), "miss_corr": min(expit(theta[3]), 0.999),
             "visibility_slope": float(np.clip(theta[1], 0, 100)), "height_slope": float(np.clip(theta[2], -10, 10)),
             "reference_height": float(knee), "min_visibility": min_visibility,
             "box_outlier_prob": float(poor[detected & after_good].mean()) if (detected & after_good).any() else 0.0,
@@ -232,7 +253,8 @@ def _fit_misses(a: Associated) -> dict:
 def _fit_boxes(a: Associated) -> dict:
     """Moments of the true detections' boxes: scale and aspect from the mean log size ratios; the residuals about
     the scaled box, in units of its sqrt(w h): their second moments, lag-1 and lag-2 covariances of a person's
-    residuals give the AR(1) drift (pooled over the four coordinates) and the per-frame noise; outliers."""
+    residuals give the AR(1) drift (of the centre and of the size, one correlation) and the per-frame noise;
+    outliers."""
     order, cont = _chains(a)
     hit, box, match = a.hit[order], a.box[order], a.match[order]
     ratio = np.log(match[hit, 2:] / box[hit, 2:])
@@ -240,19 +262,26 @@ def _fit_boxes(a: Associated) -> dict:
     wh = box[:, 2:] * scale * np.array([np.sqrt(aspect), 1 / np.sqrt(aspect)])
     unit = np.sqrt(np.prod(wh, axis=1))[:, None]
     e = np.c_[match[:, :2] + match[:, 2:] / 2 - box[:, :2] - box[:, 2:] / 2, match[:, 2:] - wh] / unit
-    centre, size = float(np.mean(e[hit, :2] ** 2)), float(np.mean(e[hit, 2:] ** 2))
-    lag1 = cont[1:] & hit[1:] & hit[:-1]
-    lag2 = cont[2:] & cont[1:-1] & hit[2:] & hit[:-2]
-    c1 = float(np.mean(e[1:][lag1] * e[:-1][lag1])) if lag1.any() else 0.0
-    c2 = float(np.mean(e[2:][lag2] * e[:-2][lag2])) if lag2.any() else 0.0
-    rho, drift = (min(c2 / c1, 0.999), min(c1 ** 2 / c2, centre, size)) if c1 > 0 and c2 > 0 else (0.9, 0.0)
+    (centre, c1, c2), (size, s1, s2) = _lagged(e[:, :2], hit, cont), _lagged(e[:, 2:], hit, cont)
+    # an AR(1) drift of variance D plus white noise has lag-k covariance D rho^k; one rho for centre and size
+    rho = float(np.clip((c2 + s2) / (c1 + s1), 0.0, 0.999)) if c1 + s1 > 0 else 0.9
+    drift, size_drift = (min(c1 / rho, centre), min(s1 / rho, size)) if rho > 0 and min(c1, s1) > 0 else (0.0, 0.0)
     outlier = a.detected & ~a.hit
     spread = a.match[outlier, :4] - a.box[outlier]  # about the true box, as outliers are drawn
     spread[:, :2] += (spread[:, 2:]) / 2
     spread /= np.sqrt(np.prod(a.box[outlier, 2:], axis=1))[:, None]
-    return {"box_noise": math.sqrt(centre - drift), "box_size_noise": math.sqrt(size - drift),
-            "box_drift": math.sqrt(drift), "box_drift_corr": rho, "box_scale": float(np.clip(scale, 0.5, 2.0)),
-            "box_aspect": float(np.clip(aspect, 0.25, 4.0)), "box_outlier_noise": float(np.clip(np.sqrt(np.mean(spread ** 2)), 0.01, 2)) if outlier.any() else 0.3}
+    return {"box_noise": math.sqrt(centre - drift), "box_size_noise": math.sqrt(size - size_drift),
+            "box_drift": math.sqrt(drift), "box_size_drift": math.sqrt(size_drift), "box_drift_corr": rho,
+            "box_scale": float(np.clip(scale, 0.5, 2.0)), "box_aspect": float(np.clip(aspect, 0.25, 4.0)),
+            "box_outlier_noise": float(np.clip(np.sqrt(np.mean(spread ** 2)), 0.01, 2)) if outlier.any() else 0.3}
+
+
+def _lagged(e: np.ndarray, hit: np.ndarray, cont: np.ndarray) -> tuple[float, float, float]:
+    """Variance and lag-1, lag-2 covariances of the residuals e (rows in chain order) over true detections."""
+    lag1 = cont[1:] & hit[1:] & hit[:-1]
+    lag2 = cont[2:] & cont[1:-1] & hit[2:] & hit[:-2]
+    cov = lambda k, sel: float(np.mean(e[k:][sel] * e[:-k][sel])) if sel.any() else 0.0  # noqa: E731
+    return float(np.mean(e[hit] ** 2)), cov(1, lag1), cov(2, lag2)
 
 
 def _fit_false_positives(a: Associated) -> dict:
@@ -326,11 +355,24 @@ def statistics(a: Associated) -> dict:
                 "false positives in runs > 1 (share)": lengths[lengths > 1].sum() / max(lengths.sum(), 1),
                 "false positives beside a person (share)": a.det_near[false].mean() if false.any() else math.nan,
                 "mean IoU of true detections": np.nanmean(a.iou[true]) if true.any() else math.nan,
+                "average precision": average_precision(a.det_conf, a.det_kind == 0, len(a.frame)),
                 "confidence, true (mean)": np.nanmean(a.conf[true]) if true.any() else math.nan,
                 "confidence, true (std)": np.nanstd(a.conf[true]) if true.any() else math.nan,
                 "confidence, false (mean)": a.det_conf[false].mean() if false.any() else math.nan,
                 "confidence, false (std)": a.det_conf[false].std() if false.any() else math.nan})
     return {k: float(v) for k, v in out.items()}
+
+
+def average_precision(conf: np.ndarray, true: np.ndarray, positives: int) -> float:
+    """Area under the precision-recall curve of detections ranked by confidence, precision made monotone (all-point
+    interpolation, as PASCAL VOC and MOTChallenge's detection benchmark); `positives`: the people to find."""
+    if not positives:
+        return math.nan
+    order = np.argsort(-conf, kind="stable")
+    tp = np.cumsum(true[order])
+    recall, precision = tp / positives, tp / np.arange(1, len(order) + 1)
+    precision = np.maximum.accumulate(precision[::-1])[::-1]
+    return float(np.sum(np.diff(np.r_[0.0, recall]) * precision))
 
 
 @dataclass(frozen=True)
@@ -356,6 +398,18 @@ def twin_detections(source: Source, sensor: dict, seed: int) -> list[np.ndarray]
     sc = source.recording.scenario({"sensor": {**sensor, "model": "synthetic"}, "env": {"obs_mode": "detections"}})
     s = SyntheticSensor(sc, np.random.default_rng(seed))
     return [s.detect(t).rows.astype(float) for t in source.truths]
+
+
+def scenario_statistics(scenario: str, config: dict | None = None, seeds: Sequence[int] = (0,),
+                        steps: int | None = None) -> dict:
+    """`statistics` of a scenario's detector on its own targets (every target, hidden ones too), episodes pooled:
+    what a preset does on a scene, e.g. its average precision."""
+    truths, detections = [], []
+    for seed in seeds:
+        t, d = scene.record(scenario, config, seed, steps)
+        truths += t
+        detections += d
+    return statistics(associate(truths, detections))
 
 
 def twin_statistics(sources: Sequence[Source], sensor: dict, seeds: int) -> dict:
@@ -415,11 +469,12 @@ def to_toml(c: Calibration) -> str:
     head = [f"# mtt-sim calibrate: the synthetic detector fitted to {', '.join(Path(s).name for s in c.sources)}",
             f"# ({c.person_frames} person-frames, {c.detections} detections). Misses: maximum likelihood; boxes, false",
             "# positives and confidences: matched moments (see mtt_sim/calibrate.py).", "[sensor]"]
-    body = [f"{k} = {_toml(v)}" for k, v in c.sensor.items()]
+    body = [f"{k} = {toml_value(v)}" for k, v in c.sensor.items()]
     return "\n".join(head + body) + "\n"
 
 
-def _toml(value) -> str:
+def toml_value(value) -> str:
+    """A scalar as TOML text."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):

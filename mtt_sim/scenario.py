@@ -134,15 +134,22 @@ class RenderConfig:
     shake: float = spec(3.0, "shake: standard deviation of the camera offset", "px", 0.0, 100.0)
 
 
+def _fitted_detectors() -> dict[str, dict[str, Any]]:
+    """The fitted detectors shipped as mtt_sim/detectors/<name>.toml, each a [sensor] table whose header says what it
+    is fitted to; `model` and `memory` stay the scenario's own."""
+    out = {}
+    for entry in sorted(resources.files("mtt_sim").joinpath("detectors").iterdir(), key=lambda p: p.name):
+        if entry.name.endswith(".toml"):
+            table = tomllib.loads(entry.read_text())["sensor"]
+            out[entry.name[:-5]] = {k: v for k, v in table.items() if k not in ("model", "memory")}
+    return out
+
+
 PRESETS: dict[str, dict[str, Any]] = {
-    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_size_noise=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0,
-                  clutter_rate=0.0, conf_true=0.95, conf_false=0.3),
-    "dpm": dict(pd=0.8, min_visibility=0.3, box_noise=0.08, box_scale=1.15, fragment_prob=0.03, merge_prob=0.3,
-                clutter_rate=3.0, conf_true=0.6, conf_false=0.35, conf_spread=5.0),
-    "frcnn": dict(pd=0.9, min_visibility=0.25, box_noise=0.04, box_scale=1.0, fragment_prob=0.0, merge_prob=0.15,
-                  clutter_rate=0.5, conf_true=0.9, conf_false=0.45),
-    "sdp": dict(pd=0.93, min_visibility=0.2, box_noise=0.03, box_scale=1.0, fragment_prob=0.0, merge_prob=0.1,
-                clutter_rate=0.3, conf_true=0.92, conf_false=0.4),
+    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_size_noise=0.0, box_drift=0.0, box_outlier_prob=0.0,
+                  box_outlier_persist=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0, clutter_rate=0.0,
+                  site_rate=0.0, conf_true=0.95, conf_false=0.3),
+    **_fitted_detectors(),
 }
 
 
@@ -158,7 +165,7 @@ class SensorConfig:
     model: str = spec("synthetic", "synthetic: from the truth and the label map; foreground: background subtraction on "
                       "the frame; recorded: a sequence folder's det/det.txt (its default; synthetic replays its ground "
                       "truth through the synthetic detector instead)", choices=("synthetic", "foreground", "recorded"))
-    preset: str = spec("", "fill the keys below from a detector preset (see README: what each is fitted to)",
+    preset: str = spec("", "fill the keys below from a detector preset (docs/detectors.md: what each is fitted to)",
                        choices=("",) + tuple(PRESETS))
     memory: bool = spec(True, "errors persist: misses follow each target's last outcome, boxes drift, false-positive "
                         "sites last site_life frames; false: every frame drawn independently with the same rates")
@@ -166,6 +173,9 @@ class SensorConfig:
                      0.0, 1.0)
     miss_corr: float = spec(0.5, "frame-to-frame correlation of a target's misses: P(detect) is P + (1 - P) miss_corr "
                             "after a detection and P (1 - miss_corr) after a miss", "", 0.0, 0.999)
+    pd_spread: float = spec(0.0, "spread of each target's own ease of detection, drawn once: N(0, pd_spread) on the "
+                            "logit of P(detect) (some people are found in almost every frame, some hardly ever)",
+                            "logit", 0.0, 10.0)
     visibility_slope: float = spec(4.0, "logit of P(detect) gained per unit of visible fraction", "logit", 0.0, 100.0)
     height_slope: float = spec(0.0, "logit of P(detect) lost per halving of the box height below reference_height",
                                "logit", -10.0, 10.0)
@@ -175,8 +185,9 @@ class SensorConfig:
                             "sqrt(w h) (standard deviation)", "", 0.0, 1.0)
     box_size_noise: float = spec(0.03, "per-frame noise of the box width and height, in units of sqrt(w h)", "",
                                  0.0, 1.0)
-    box_drift: float = spec(0.0, "per-target drift of centre and size, AR(1) with this stationary standard deviation "
+    box_drift: float = spec(0.0, "per-target drift of the box centre, AR(1) with this stationary standard deviation "
                             "(units of sqrt(w h)), on top of the per-frame noise", "", 0.0, 1.0)
+    box_size_drift: float = spec(0.0, "the same for the box width and height", "", 0.0, 1.0)
     box_drift_corr: float = spec(0.9, "frame-to-frame correlation of the box drift", "", 0.0, 0.999)
     box_outlier_prob: float = spec(0.0, "probability a detection's box is an outlier (IoU 0.3-0.5 with its target's) "
                                    "when the target's last box was good", "", 0.0, 1.0)
@@ -504,17 +515,27 @@ def resolve(name: str | Path) -> str | Path:
                       + f"; available: {', '.join(keys)} (in any case, or their env ids, a .toml file or a sequence folder)")
 
 
-def load_raw(key_or_path: str | Path) -> tuple[dict, str]:
-    """Read a scenario's TOML mapping by shipped key (see `resolve`) or file path; returns (mapping, where)."""
+def load_raw(key_or_path: str | Path, seen: tuple[str, ...] = ()) -> tuple[dict, str]:
+    """Read a scenario's TOML mapping by shipped key (see `resolve`) or file path; returns (mapping, where).
+    A file with `base = "<scenario>"` is that scenario's mapping with the file's keys merged over it (a variant)."""
     found = resolve(key_or_path)
     if isinstance(found, Path):
         text, where = found.read_text(), str(found)
     else:
         text, where = (scenario_dir() / f"{found}.toml").read_text(), f"scenarios/{found}.toml"
     try:
-        return tomllib.loads(text), where
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"{where}: invalid TOML: {err}") from None
+    if "base" not in raw:
+        return raw, where
+    base = raw.pop("base")
+    if not isinstance(base, str) or base in seen:
+        raise ConfigError(f"{where}: base = {base!r}: expected the name of another scenario, without a cycle")
+    try:
+        return merge(load_raw(base, (*seen, str(found)))[0], raw), where
+    except ConfigError as err:
+        raise ConfigError(f"{where}: base = {base!r}: {err}") from None
 
 
 def expand_dotted(overrides: Mapping, prefix: str = "") -> dict:

@@ -2,11 +2,12 @@
 
 ``synthetic`` reads the truth (and the label map, where there is one) and fails the way real detectors fail
 (``mtt_sim.calibrate`` fits it to real detections):
-- misses: P(detect) is logistic in the visible fraction and the log of the box height, raised for a target detected
-  in the previous frame and lowered after a miss (a two-state Markov chain per target), so misses come in runs;
+- misses: P(detect) is logistic in the visible fraction, the log of the box height and the target's own ease of
+  detection (drawn once), raised for a target detected in the previous frame and lowered after a miss (a two-state
+  Markov chain per target), so misses come in runs;
 - boxes: the visible extent with per-frame noise and a per-target AR(1) drift of offset and size, true detections
-  (IoU >= 0.5 with it); some are outliers (IoU 0.3-0.5), more often after an outlier or a miss; targets whose visible regions touch may merge into one box; fragments (always where an occluder cuts a target
-  apart);
+  (IoU >= 0.5 with it); some are outliers (IoU 0.3-0.5), more often after an outlier or a miss; targets whose
+  visible regions touch may merge into one box; fragments (always where an occluder cuts a target apart);
 - false positives: fresh Poisson clutter and persistent sites, static or held beside a target;
 - confidences: Beta draws, their mean for true detections logistic in visibility and height.
 With ``memory = false`` every frame is drawn independently at the same rates. ``foreground`` runs background
@@ -41,13 +42,16 @@ class Detections:
     sources: np.ndarray  # (n,) int64: target id, CLUTTER or UNKNOWN
 
 
-def detection_probabilities(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig):
+def detection_probabilities(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig,
+                            ease: np.ndarray | float = 0.0):
     """(P, P(detect | detected before), P(detect | missed before)) per target.
 
-    logit P = logit(pd) + visibility_slope (visibility - 1) + height_slope log_height, 0 at or below min_visibility. A two-state chain with lag-1 correlation miss_corr has P as its long-run share of detected
-    frames: after a detection P + (1 - P) miss_corr, after a miss P (1 - miss_corr).
+    logit P = logit(pd) + visibility_slope (visibility - 1) + height_slope log_height + ease (the target's own
+    detectability, N(0, pd_spread) drawn once), 0 at or below min_visibility. A two-state chain with lag-1
+    correlation miss_corr has P as its long-run share of detected frames: after a detection P + (1 - P) miss_corr,
+    after a miss P (1 - miss_corr).
     """
-    shift = cfg.visibility_slope * (visibility - 1) + cfg.height_slope * log_height(height, cfg)
+    shift = cfg.visibility_slope * (visibility - 1) + cfg.height_slope * log_height(height, cfg) + ease
     with np.errstate(divide="ignore"):
         p = np.where(visibility > cfg.min_visibility, expit(logit(cfg.pd) + shift), 0.0)
     return p, p + (1 - p) * cfg.miss_corr, p * (1 - cfg.miss_corr)
@@ -190,26 +194,24 @@ class Sensor:
 
 
 class _Memory:
-    """Per target id, from the last frame it was seen: how it was reported (MISSED, GOOD, POOR), its box drift and
-    the offsets of its outlier box (kept while it stays poor)."""
+    """Per target id, from the last frame it was seen: how it was reported (MISSED, GOOD, POOR), its box drift, the
+    offsets of its outlier box (kept while it stays poor) and its ease of detection."""
 
     def __init__(self):
-        self.ids, self.state, self.offsets = np.zeros(0, np.int64), np.zeros(0, np.int8), np.zeros((0, 8))
+        self.ids, self.state, self.values = np.zeros(0, np.int64), np.zeros(0, np.int8), np.zeros((0, 9))
 
-    def recall(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(known, state, drift, outlier offsets) for each id; unknown ids get MISSED and zeros."""
+    def recall(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(known, state, drift, outlier offsets, ease) for each id; unknown ids get MISSED and zeros."""
         row = _rows_of(self.ids, ids)
-        known = row >= 0
-        if not known.any():
-            return known, np.zeros(len(ids), np.int8), np.zeros((len(ids), 4)), np.zeros((len(ids), 4))
-        r = np.where(known, row, 0)
-        offsets = np.where(known[:, None], self.offsets[r], 0.0)
-        return known, np.where(known, self.state[r], MISSED), offsets[:, :4], offsets[:, 4:]
+        known, r = row >= 0, np.maximum(row, 0)
+        values = np.where(known[:, None], self.values[r], 0.0) if len(self.ids) else np.zeros((len(ids), 9))
+        state = np.where(known, self.state[r], MISSED) if len(self.ids) else np.full(len(ids), MISSED, np.int8)
+        return known, state, values[:, :4], values[:, 4:8], values[:, 8]
 
-    def store(self, ids: np.ndarray, state: np.ndarray, drift: np.ndarray, poor: np.ndarray) -> None:
+    def store(self, ids: np.ndarray, state: np.ndarray, drift: np.ndarray, poor: np.ndarray, ease: np.ndarray) -> None:
         """Keep these targets' outcomes; targets absent from this frame are forgotten."""
         order = np.argsort(ids, kind="stable")
-        self.ids, self.state, self.offsets = ids[order], state[order], np.c_[drift, poor][order]
+        self.ids, self.state, self.values = ids[order], state[order], np.c_[drift, poor, ease][order]
 
 
 class _Sites:
@@ -268,8 +270,10 @@ class SyntheticSensor(Sensor):
 
     def detect(self, truth: Truth, labels: np.ndarray | None = None, frame: np.ndarray | None = None) -> Detections:
         cfg, rng = self.cfg, self.rng
-        marginal, after_hit, after_miss = detection_probabilities(truth.visibility, truth.boxes[:, 3], cfg)
-        known, last, drift, poor = self.memory.recall(truth.ids)
+        known, last, drift, poor, ease = self.memory.recall(truth.ids)
+        if cfg.pd_spread > 0:  # a new target's ease, or (without memory) every target's, drawn afresh
+            ease = np.where(known & cfg.memory, ease, rng.normal(0, cfg.pd_spread, len(known)))
+        marginal, after_hit, after_miss = detection_probabilities(truth.visibility, truth.boxes[:, 3], cfg, ease)
         pd = np.where(known, np.where(last != MISSED, after_hit, after_miss), marginal) if cfg.memory else marginal
         drift = self._drift(known, drift)
         cand = np.flatnonzero(truth.visibility > cfg.min_visibility)
@@ -283,9 +287,10 @@ class SyntheticSensor(Sensor):
             poor[lead[outlier]] = np.where((cfg.memory & (last[lead[outlier]] == POOR))[:, None], poor[lead[outlier]], fresh)
         state = np.zeros(len(truth), np.int8)
         state[cand] = np.where(hit, GOOD, np.where(outlier, POOR, MISSED))[obj]
-        self.memory.store(truth.ids, state, drift, poor)
+        self.memory.store(truth.ids, state, drift, poor, ease)
         boxes, means, rows, kind = self._reports(truth, box, lead, hit, outlier, np.bincount(obj) == 1)
-        if cfg.box_noise or cfg.box_size_noise or cfg.box_drift or cfg.box_scale != 1 or cfg.box_aspect != 1:
+        if cfg.box_noise or cfg.box_size_noise or cfg.box_drift or cfg.box_size_drift or cfg.box_scale != 1 \
+                or cfg.box_aspect != 1:
             boxes[kind < 2] = self._noisy(boxes[kind < 2], drift[rows[kind < 2]], whole=kind[kind < 2] == 0)
         if outlier.any():
             boxes[kind == 2] = displace(box[outlier], poor[lead[outlier]])
@@ -348,27 +353,28 @@ class SyntheticSensor(Sensor):
     def _drift(self, known: np.ndarray, drift: np.ndarray) -> np.ndarray:
         """This frame's per-target box drift: AR(1) from the last for known targets, stationary for new ones."""
         cfg = self.cfg
-        if not cfg.memory or cfg.box_drift == 0:
+        if not cfg.memory or cfg.box_drift == cfg.box_size_drift == 0:
             return np.zeros((len(known), 4))
         rho = cfg.box_drift_corr
-        fresh = self.rng.normal(0, cfg.box_drift, (len(known), 4))
+        fresh = self.rng.normal(0, 1, (len(known), 4)) * np.array([cfg.box_drift] * 2 + [cfg.box_size_drift] * 2)
         return np.where(known[:, None], rho * drift + np.sqrt(1 - rho**2) * fresh, fresh)
 
     def _noisy(self, boxes: np.ndarray, drift: np.ndarray, whole: np.ndarray) -> np.ndarray:
         """True boxes scaled by box_scale and box_aspect about their centres, with their target's drift and per-frame
         noise; the noise of a whole box is drawn to keep it a true detection (IoU >= 0.5 with the box; where a few
-        draws miss that, drift alone). Without memory the drift's variance joins the per-frame noise."""
+        draws miss that, the scaled box alone: a drift that strays too far is a poor box, which outliers model).
+        Without memory the drift's variance joins the per-frame noise."""
         cfg = self.cfg
         centre, size = cfg.box_noise, cfg.box_size_noise
         if not cfg.memory:
-            centre, size = np.hypot(centre, cfg.box_drift), np.hypot(size, cfg.box_drift)
+            centre, size = np.hypot(centre, cfg.box_drift), np.hypot(size, cfg.box_size_drift)
         root = np.sqrt(cfg.box_aspect)
         wh = boxes[:, 2:] * cfg.box_scale * np.array([root, 1 / root])
         scaled = np.concatenate([boxes[:, :2] + (boxes[:, 2:] - wh) / 2, wh], axis=1)
         offsets = drift + self._frame_noise(len(boxes), centre, size)
         if whole.any():
             offsets[whole] = offsets_in_band(boxes[whole], scaled[whole], drift[whole], np.array([centre, centre, size, size]),
-                                             TRUE_BAND, self.rng, drift[whole])
+                                             TRUE_BAND, self.rng, np.zeros_like(drift[whole]))
         return displace(scaled, offsets)
 
     def _frame_noise(self, n: int, centre: float, size: float) -> np.ndarray:

@@ -32,7 +32,7 @@ def test_unknown_scenario_lists_the_available_ones():
     ({"groups.0.color": [1, 2]}, r"groups\.0\.color = \[1, 2\]: expected 3 values"),
     ({"groups.0.speed": float("nan")}, r"groups\.0\.speed = nan: expected a finite number"),
     ({"groups.5.speed": 1.0}, r"override groups\.5: no such item; groups has 2 entries"),
-    ({"sensor.preset": "yolo"}, r"sensor\.preset = 'yolo': allowed values: 'ideal', 'dpm', 'frcnn', 'sdp'"),
+    ({"sensor.preset": "yolo"}, r"sensor\.preset = 'yolo': allowed values: 'ideal', 'dpm', 'frcnn', 'mot15_frcnn', 'sdp'"),
 ])
 def test_bad_values_name_the_file_the_key_and_what_is_allowed(overrides, pattern):
     with pytest.raises(ConfigError, match=pattern) as err:

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
-from mtt_sim import TrackingEnv
+from mtt_sim import TrackingEnv, scene
+from mtt_sim.scenario import ConfigError, load
 from mtt_sim.sensor import CLUTTER
+from mtt_sim.truth import Truth
 
 NO_TRACKS = {"ids": [], "boxes": np.zeros((0, 4))}
 
@@ -99,3 +101,37 @@ def test_dense_two_hundred_touching_targets():
     _, rec = run("dense", 30, obs_mode="detections")
     assert all(len(t) == 200 for t, *_ in rec)
     assert np.mean([(t.visibility < 1).sum() for t, *_ in rec]) > 2
+
+
+def walker(ids, path):
+    """Truths of one person of height 50 walking through the given feet positions, one per frame."""
+    return [Truth(ids=np.array([ids]), boxes=np.array([[x - 10.0, y - 50.0, 20.0, 50.0]], np.float32),
+                  visibility=np.ones(1, np.float32), visible_boxes=np.zeros((1, 4), np.float32),
+                  depth=np.zeros(1, np.float32), labels=np.ones(1, int), pieces=np.zeros((0, 5), np.float32))
+            for x, y in path]
+
+
+def test_heading_changes_by_hand():
+    straight = [(10.0 * k, 0.0) for k in range(11)]
+    assert scene.heading_changes(walker(1, straight)).tolist() == [0.0]
+    corner = [(10.0 * k, 0.0) for k in range(6)] + [(50.0, 10.0 * k) for k in range(1, 6)]  # right, then down
+    assert scene.heading_changes(walker(1, corner)) == pytest.approx([90.0])
+    still = [(0.0, 0.0)] * 11  # no direction to speak of
+    assert len(scene.heading_changes(walker(1, still))) == 0
+
+
+def test_mot17_like_has_mot17_scene_statistics():
+    truths, _ = scene.record("mot17_like", seed=0)
+    stats = scene.summary(truths)
+    assert len(truths) >= 600
+    assert 16 <= stats["people per frame"] <= 28  # MOT17: 21 on average
+    assert 12 <= stats["heading change p90 (deg)"] <= 20  # real TUD and MOT17 trajectories
+
+
+def test_a_variant_is_its_base_with_its_own_keys(tmp_path):
+    moving = load("mot17_moving")
+    assert moving.render.camera == "pan" and moving.world.size == (1440.0, 540.0)
+    assert moving.sensor == load("mot17_like").sensor and moving.groups[0].count == 14
+    (tmp_path / "loop.toml").write_text(f'base = "{tmp_path / "loop.toml"}"\n')
+    with pytest.raises(ConfigError, match="without a cycle"):
+        load(tmp_path / "loop.toml")
