@@ -117,15 +117,15 @@ class TrackingEnv(gym.Env):
 
     @staticmethod
     def _spaces(sc: scn.Scenario, recording: Recording | None = None):
-        """Simulated detections lie in the image with confidences in conf_offset + [0, conf_scale] (float32; float64
-        on a recorded sequence); recorded ones are given as written, so their bounds are widened to the extremes of
-        the sequence's det.txt."""
+        """Simulated detections lie in the image with confidences in conf_offset + [0, conf_scale], and the rows past
+        num_detections are zeros (float32; float64 on a recorded sequence); recorded ones are given as written, so
+        their bounds are widened to the extremes of the sequence's det.txt."""
         w, h = sc.render.width, sc.render.height
         nd, nt = sc.sensor.max_detections, sc.env.max_tracks
         dtype = np.float32 if recording is None else np.float64
         s = sc.sensor
-        det_low = np.array([0, 0, 0, 0, s.conf_offset])
-        det_high = np.array([w, h, w, h, s.conf_offset + s.conf_scale])
+        det_low = np.array([0, 0, 0, 0, min(s.conf_offset, 0.0)])
+        det_high = np.array([w, h, w, h, max(s.conf_offset + s.conf_scale, 0.0)])
         if recording is not None and s.model == "recorded":
             det_low = np.minimum(det_low, np.floor(recording.det_range[0]))
             det_high = np.maximum(det_high, np.ceil(recording.det_range[1]))
