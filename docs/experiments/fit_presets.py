@@ -5,7 +5,7 @@ benchmark: DPM 0.61, FRCNN 0.72, SDP 0.81). How a detector fails over time is no
 its recall comes from `mot15_frcnn` (fitted by `mtt-sim calibrate` to the eight shared MOT15 sequences' Faster R-CNN
 detections): a preset is that detector with P(detect) shifted by one number d on the logit scale, d found by
 bisection so that the average precision over mot17_like's people (seeds 0 and 1, 600 frames) is the published one,
-or as near as the shift can bring it (people fully hidden or a few pixels tall stay missed whatever d is).
+or as near as the shift can bring it (poor boxes, IoU 0.3 to 0.5 with the person, stay misses whatever d is).
 
     python docs/experiments/fit_presets.py          # writes mtt_sim/detectors/{dpm,frcnn,sdp}.toml, prints the fit
 """
@@ -21,7 +21,9 @@ DETECTORS = Path(__file__).resolve().parents[2] / "mtt_sim" / "detectors"
 
 
 def shifted(base: dict, d: float) -> dict:
-    return {**base, "pd": float(expit(logit(base["pd"]) + d))}
+    """mot15_frcnn with P(detect) shifted by d, its confidences spread over [0, 1] (the SORT files keep only scores
+    above 0.5; MOT17's files keep low ones too, which ByteTrack's and lmb's second rounds use)."""
+    return {**base, "pd": float(expit(logit(base["pd"]) + d)), "conf_offset": 0.0, "conf_scale": 1.0}
 
 
 def mot17_like_ap(sensor: dict) -> float:
@@ -43,7 +45,8 @@ def main():
         print(f"{name}: d = {d:+.3f}, pd {keys['pd']:.4f}: average precision on mot17_like {ap:.3f} (published {target})")
         head = (f"# The {name.upper()} detector of MOT17 (average precision {target} on MOT17Det): mot15_frcnn with "
                 f"P(detect) shifted by\n# d = {d:+.3f} on the logit scale, so that its average precision over "
-                f"mot17_like's people is {ap:.3f}.\n# Written by docs/experiments/fit_presets.py.\n")
+                f"mot17_like's people is {ap:.3f},\n# and its confidences spread over [0, 1]. Written by "
+                "docs/experiments/fit_presets.py.\n")
         (DETECTORS / f"{name}.toml").write_text(head + "[sensor]\n" + "".join(
             f"{k} = {calibrate.toml_value(round(v, 4) if isinstance(v, float) else v)}\n" for k, v in keys.items()))
 
