@@ -152,10 +152,10 @@ def miss_statistics(frames):
 
 def test_misses_persist_with_memory_and_not_without_at_the_same_rate():
     keys = {"pd": 0.7, "miss_corr": 0.6, "reference_height": 40.0}
-    p_miss, p_miss_after_miss = miss_statistics(frames_of(keys, 20000))
-    assert abs(p_miss - 0.3) < 0.02 and abs(p_miss_after_miss - (1 - 0.7 * 0.4)) < 0.02  # 0.72
-    p_miss, p_miss_after_miss = miss_statistics(frames_of({**keys, "memory": False}, 20000))
-    assert abs(p_miss - 0.3) < 0.02 and abs(p_miss_after_miss - 0.3) < 0.02
+    p_miss, p_miss_after_miss = miss_statistics(frames_of(keys, 8000))
+    assert abs(p_miss - 0.3) < 0.03 and abs(p_miss_after_miss - (1 - 0.7 * 0.4)) < 0.03  # 0.72
+    p_miss, p_miss_after_miss = miss_statistics(frames_of({**keys, "memory": False}, 8000))
+    assert abs(p_miss - 0.3) < 0.03 and abs(p_miss_after_miss - 0.3) < 0.03
 
 
 def test_false_positive_sites_repeat_their_box_for_their_life():
