@@ -137,6 +137,21 @@ def test_new_then_normal_then_vanished_and_ended_after_three_misses():
     assert len(t.ids) == 0 and t.ended["ids"].tolist() == [1]
 
 
+def test_a_confirmed_target_stays_confirmed_through_a_miss():
+    a = lambda k: (20 + 2 * k, 50) if k != 10 else None  # noqa: E731 (one missed detection)
+    _, out = run([a], 14, min_hits=3)
+    assert [o[0] for o in out[:4]] == [[], [], [1], [1]]  # confirmed at its third frame
+    assert out[10][0] == [] and out[11][0] == [1]  # not re-counted: back at once after the miss
+
+
+def test_with_coast_a_confirmed_target_is_reported_while_missed_until_it_vanishes():
+    a = lambda k: (20 + 2 * k, 50) if k < 10 else None  # noqa: E731
+    _, out = run([a], 15, min_hits=3, coast=True)
+    assert [o[0] for o in out[10:15]] == [[1], [1], [], [], []]  # coasts 2 frames, ended at the third miss
+    _, out = run([a], 15, min_hits=3)
+    assert [o[0] for o in out[10:15]] == [[]] * 5  # the paper's: only targets with a measurement this frame
+
+
 def test_a_target_reappearing_soon_is_revived_with_its_id():
     a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 14 else None  # noqa: E731 (4 frames missed: ended, then back)
     t, out = run([a], 20)

@@ -141,8 +141,9 @@ class Jpda(Tracker):
     occluded targets jump to the shared measurement with zero velocity; a target vanished for vanish_frames frames is
     ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
-    last size. Reported: targets that had a measurement this frame (and min_hits frames in a row; 1 in the paper,
-    which reports every new target at once). situations=false drops the occlusion correction, the separation,
+    last size. Reported: confirmed targets (once they have had a measurement min_hits frames in a row; 1 in the
+    paper, which reports every new target at once) that had a measurement this frame, or, with coast=true, that
+    have not yet vanished (their prediction, as Stone Soup reports tracks). situations=false drops the occlusion correction, the separation,
     the duplicate rule and the revival (plain JPDA with births and deaths); occlusion_velocity=keep keeps each
     occluded target's velocity (the paper zeroes it); k=0 means the paper's K. Deviations from the paper,
     each a gap it leaves open: merged targets coming apart take one measurement each from the best joint event;
@@ -155,17 +156,18 @@ class Jpda(Tracker):
                   "revive_frames": Param(5, "[0, inf)"), "accel_sigma": Param(0.5, "[0, inf)"),
                   "meas_sigma": Param(4.0, "(0, inf)"), "min_confidence": Param(0.0), "situations": Param(True),
                   "occlusion_velocity": Param("zero", ("keep", "zero")), "speed_sigma0": Param(2.0, "(0, inf)"),
-                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)")}
+                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(False)}
 
     def reset(self, info=None):
         p = self.params
         self.model = point_model(p["accel_sigma"], p["meas_sigma"], p["speed_sigma0"])
         self.kf = KalmanBank(self.model)
         self.ids, self.misses, self.hits = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.confirmed = np.zeros(0, bool)
         self.age, self.together = np.zeros(0, np.int64), np.zeros(0, np.int64)
         self.sizes = np.zeros((0, 2))
         self.ended = {"ids": np.zeros(0, np.int64), "age": np.zeros(0, np.int64), "sizes": np.zeros((0, 2)),
-                      "bank": KalmanBank(self.model)}
+                      "confirmed": np.zeros(0, bool), "bank": KalmanBank(self.model)}
         self.next_id = 1
         self.gate = chi2_gate(2, p["gate_probability"])
         self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool),
@@ -213,7 +215,8 @@ class Jpda(Tracker):
         self._add(z[fresh], dets[fresh, 2:4])
         self.last["situations"] += [REVIVED] * (len(self.ids) - len(situ) - len(fresh)) + [NEW] * len(fresh)
         self.hits = np.where(self.misses == 0, self.hits + 1, 0)
-        seen = (self.misses == 0) & (self.hits >= p["min_hits"])
+        self.confirmed |= self.hits >= p["min_hits"]  # once: a confirmed target stays confirmed through its misses
+        seen = self.confirmed & ((self.misses == 0) | p["coast"])
         centre = self.kf.x[seen, :2]
         return Tracks.of(self.ids[seen], np.c_[centre - self.sizes[seen] / 2, self.sizes[seen]])
 
@@ -299,6 +302,7 @@ class Jpda(Tracker):
         gone = self.misses >= self.params["vanish_frames"]
         e = self.ended
         e["ids"] = np.r_[e["ids"], self.ids[gone]]
+        e["confirmed"] = np.r_[e["confirmed"], self.confirmed[gone]]
         e["age"] = np.r_[e["age"], np.zeros(gone.sum(), np.int64)]
         e["sizes"] = np.r_[e["sizes"], self.sizes[gone]]
         e["bank"].x, e["bank"].P = np.r_[e["bank"].x, self.kf.x[gone]], np.r_[e["bank"].P, self.kf.P[gone]]
@@ -309,7 +313,7 @@ class Jpda(Tracker):
         bring it back; the others are returned as new targets."""
         e = self.ended
         young = e["age"] <= self.params["revive_frames"]
-        for k in ("ids", "age", "sizes"):
+        for k in ("ids", "age", "sizes", "confirmed"):
             e[k] = e[k][young]
         e["bank"].keep(young)
         if not len(unexplained) or not len(e["ids"]):
@@ -322,13 +326,14 @@ class Jpda(Tracker):
             self.ids = np.r_[self.ids, e["ids"][rows]]
             self.misses = np.r_[self.misses, np.zeros(len(rows), np.int64)]
             self.hits = np.r_[self.hits, np.zeros(len(rows), np.int64)]
+            self.confirmed = np.r_[self.confirmed, e["confirmed"][rows]]
             self.age = np.r_[self.age, np.full(len(rows), self.params["vanish_frames"], np.int64)]
             self.together = np.r_[self.together, np.zeros(len(rows), np.int64)]
             self.sizes = np.r_[self.sizes, dets[unexplained[cols], 2:4]]
             self.kf.x, self.kf.P = np.r_[self.kf.x, e["bank"].x[rows]], np.r_[self.kf.P, e["bank"].P[rows]]
             keep = np.ones(len(e["ids"]), bool)
             keep[rows] = False
-            for k in ("ids", "age", "sizes"):
+            for k in ("ids", "age", "sizes", "confirmed"):
                 e[k] = e[k][keep]
             e["bank"].keep(keep)
         return np.setdiff1d(unexplained, unexplained[cols])
@@ -340,6 +345,7 @@ class Jpda(Tracker):
         self.next_id += len(z)
         self.misses = np.r_[self.misses, np.zeros(len(z), np.int64)]
         self.hits = np.r_[self.hits, np.zeros(len(z), np.int64)]
+        self.confirmed = np.r_[self.confirmed, np.zeros(len(z), bool)]
         self.age = np.r_[self.age, np.zeros(len(z), np.int64)]
         self.together = np.r_[self.together, np.zeros(len(z), np.int64)]
         self.sizes = np.r_[self.sizes, sizes]
@@ -347,6 +353,7 @@ class Jpda(Tracker):
     def _keep(self, mask: np.ndarray) -> None:
         self.kf.keep(mask)
         self.ids, self.misses, self.hits = self.ids[mask], self.misses[mask], self.hits[mask]
+        self.confirmed = self.confirmed[mask]
         self.age, self.together, self.sizes = self.age[mask], self.together[mask], self.sizes[mask]
 
     def debug(self) -> list[dict]:
