@@ -152,6 +152,16 @@ def test_with_coast_a_confirmed_target_is_reported_while_missed_until_it_vanishe
     assert [o[0] for o in out[10:15]] == [[]] * 5  # the paper's: only targets with a measurement this frame
 
 
+@pytest.mark.parametrize("fix", [{"early_duplicates": True}, {"occlusion_covariance": "full"}])
+def test_a_duplicate_born_beside_its_target_does_not_cost_the_target_its_id(fix):
+    a = lambda k: (20 + 5 * k, 50)  # noqa: E731
+    dup = lambda k: (20 + 5 * k, 56) if k == 15 else None  # noqa: E731 (one stray detection, just outside the gate)
+    _, out = run([a, dup], 30, meas_sigma=1.0)
+    assert out[17][1] == [OCCLUDED, OCCLUDED] and out[-1][0] == [3]  # the paper's rule: snapped at rest, then lost
+    _, out = run([a, dup], 30, meas_sigma=1.0, **fix)
+    assert out[15][0] == [1, 2] and all(o[0] == [1] for o in out[16:])
+
+
 def test_a_target_reappearing_soon_is_revived_with_its_id():
     a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 14 else None  # noqa: E731 (4 frames missed: ended, then back)
     t, out = run([a], 20)

@@ -145,7 +145,10 @@ class Jpda(Tracker):
     paper, which reports every new target at once) that had a measurement this frame, or, with coast=true, that
     have not yet vanished (their prediction, as Stone Soup reports tracks). situations=false drops the occlusion correction, the separation,
     the duplicate rule and the revival (plain JPDA with births and deaths); occlusion_velocity=keep keeps each
-    occluded target's velocity (the paper zeroes it); k=0 means the paper's K. Deviations from the paper,
+    occluded target's velocity (the paper zeroes it); occlusion_covariance=full restarts the velocity's covariance
+    with the zeroed velocity (position: only the position's, as before); early_duplicates=true drops a newborn
+    duplicate sharing a blob with its elder before the situations are classified, so the elder is not snapped to
+    the blob (false: afterwards, as before); k=0 means the paper's K. Deviations from the paper,
     each a gap it leaves open: merged targets coming apart take one measurement each from the best joint event;
     duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped."""
 
@@ -156,7 +159,8 @@ class Jpda(Tracker):
                   "revive_frames": Param(5, "[0, inf)"), "accel_sigma": Param(0.5, "[0, inf)"),
                   "meas_sigma": Param(4.0, "(0, inf)"), "min_confidence": Param(0.0), "situations": Param(True),
                   "occlusion_velocity": Param("zero", ("keep", "zero")), "speed_sigma0": Param(2.0, "(0, inf)"),
-                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(False)}
+                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(False),
+                  "early_duplicates": Param(False), "occlusion_covariance": Param("position", ("position", "full"))}
 
     def reset(self, info=None):
         p = self.params
@@ -185,6 +189,10 @@ class Jpda(Tracker):
         self.ended["age"] += 1
         beta, gated, g = self._associate(z)
         situ, unexplained = situations(beta[:, 1:].T)
+        if p["situations"] and p["early_duplicates"] and len(z) and \
+                self._drop_duplicates(situ, np.argmax(beta[:, 1:], axis=1), newborn_only=True):
+            beta, gated, g = self._associate(z)  # without the newborn duplicates: the elder is not snapped
+            situ, unexplained = situations(beta[:, 1:].T)
         if p["situations"]:
             self._separate(situ, beta, g)
         self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": self.ids.copy(),
@@ -200,6 +208,8 @@ class Jpda(Tracker):
         self.kf.x[occluded, :2] = z[best[occluded]]
         if p["occlusion_velocity"] == "zero":
             self.kf.x[occluded, 2:] = 0.0
+            if p["occlusion_covariance"] == "full":  # a velocity set to 0 is not known: its covariance restarts too
+                self.kf.P[occluded, 2:, 2:] = self.model.P0[2:, 2:]
         self.kf.P[occluded, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
         self.kf.P[occluded, :2, 2:] = self.kf.P[occluded, 2:, :2] = 0.0
         sized = np.flatnonzero((kind == NORMAL) | (kind == SEPARATED))
@@ -278,24 +288,27 @@ class Jpda(Tracker):
         P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
         self.kf.P = (P + P.transpose(0, 2, 1)) / 2  # keep it symmetric against rounding
 
-    def _drop_duplicates(self, situ: list[str], best: np.ndarray) -> None:
+    def _drop_duplicates(self, situ: list[str], best: np.ndarray, newborn_only: bool = False) -> bool:
         """Targets occluded together with an older one are dropped when they are younger than vanish_frames (a
-        fragment or a clutter blob beside it) or have shared its blob for merge_frames frames (one object): the
-        paper's occlusion rule would keep such duplicates at the same place for ever."""
+        fragment or a clutter blob beside it) or, unless newborn_only, have shared its blob for merge_frames frames
+        (one object): the paper's occlusion rule would keep such duplicates at the same place for ever. Returns
+        whether any was dropped."""
         occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
         if len(occluded) < 2:
-            return
+            return False
         blob = best[occluded]
         order = np.lexsort((self.ids[occluded], -self.age[occluded], blob))  # by blob, then oldest, then lowest id
         first = np.r_[True, blob[order][1:] != blob[order][:-1]]
         keeper = np.zeros(len(occluded), bool)
         keeper[order[first]] = True  # the elder of each blob stays
         p = self.params
-        duplicate = (self.age[occluded] < p["vanish_frames"]) | (self.together[occluded] >= p["merge_frames"])
+        duplicate = (self.age[occluded] < p["vanish_frames"]) | \
+            (not newborn_only) & (self.together[occluded] >= p["merge_frames"])
         dropped = duplicate & ~keeper
         keep = np.ones(len(self.ids), bool)
         keep[occluded[dropped]] = False
         self._keep(keep)
+        return bool(dropped.any())
 
     def _end_vanished(self) -> None:
         """Targets vanished for vanish_frames frames leave the active set for the revival pool."""
