@@ -211,6 +211,7 @@ def _fit_misses(a: Associated) -> dict:
     stretch = (np.cumsum(~cont) - 1)[use]
     starts = np.flatnonzero(np.r_[True, stretch[1:] != stretch[:-1]])
     nodes, weights = np.polynomial.hermite_e.hermegauss(15)  # for a standard normal u
+    weights = weights / weights.sum()
 
     def log_q(theta, x, u):
         """log P(the observed outcome) per row (and per value of u)."""
@@ -225,7 +226,7 @@ def _fit_misses(a: Associated) -> dict:
 
     def nll(theta, x):
         per_stretch = np.add.reduceat(log_q(theta, x, np.exp(theta[4]) * nodes), starts, axis=0)
-        return -logsumexp(per_stretch, b=weights / weights.sum(), axis=1).sum()
+        return -logsumexp(per_stretch, b=weights, axis=1).sum()
 
     best = None
     start = np.array([logit(np.clip(y.mean(), 0.01, 0.99)), 2.0, 1.0, 0.0])
@@ -237,10 +238,12 @@ def _fit_misses(a: Associated) -> dict:
     _, theta, knee, x = best
     theta = minimize(nll, np.r_[theta, math.log(0.5)], args=(x,), method="L-BFGS-B",
                      bounds=[(None, None)] * 4 + [(math.log(1e-3), math.log(10.0))]).x
+    def detected_share(b0):
+        """The model's mean P(detect) over the rows with intercept b0, u integrated out."""
+        return float(np.mean(expit((x[:, 1:] @ theta[1:3] + b0)[:, None] + np.exp(theta[4]) * nodes) @ weights))
+
     # the chain's share of detected frames follows P only on average: match the intercept to the data's share
-    rate = lambda b0: float(np.mean(expit(x[:, 1:] @ theta[1:3] + b0 + np.exp(theta[4]) * nodes[:, None]).T  # noqa
-                                    @ (weights / weights.sum())))
-    theta[0] = brentq(lambda b0: rate(b0) - y.mean(), theta[0] - 10, theta[0] + 10)
+    theta[0] = brentq(lambda b0: detected_share(b0) - y.mean(), theta[0] - 10, theta[0] + 10)
     detected, poor = a.detected[order], (a.detected & ~a.hit)[order]
     after_good = np.r_[False, a.hit[order][:-1]] & cont
     return {"pd": expit(theta[0]), "pd_spread": math.exp(theta[4]), "miss_corr": min(expit(theta[3]), 0.999),
@@ -466,11 +469,16 @@ def report(c: Calibration) -> str:
 
 def to_toml(c: Calibration) -> str:
     """The fitted [sensor] table, with a header saying what it was fitted to and how."""
-    head = [f"# mtt-sim calibrate: the synthetic detector fitted to {', '.join(Path(s).name for s in c.sources)}",
-            f"# ({c.person_frames} person-frames, {c.detections} detections). Misses: maximum likelihood; boxes, false",
-            "# positives and confidences: matched moments (see mtt_sim/calibrate.py).", "[sensor]"]
-    body = [f"{k} = {toml_value(v)}" for k, v in c.sensor.items()]
-    return "\n".join(head + body) + "\n"
+    return sensor_toml(c.sensor, [
+        f"mtt-sim calibrate: the synthetic detector fitted to {', '.join(Path(s).name for s in c.sources)}",
+        f"({c.person_frames} person-frames, {c.detections} detections). Misses: maximum likelihood; boxes, false",
+        "positives and confidences: matched moments (see mtt_sim/calibrate.py)."])
+
+
+def sensor_toml(sensor: dict, comments: Sequence[str] = ()) -> str:
+    """A [sensor] table as TOML text (what read_sensor and the presets read), after a comment of these lines."""
+    return "".join(f"# {line}\n" for line in comments) + "[sensor]\n" + "".join(
+        f"{k} = {toml_value(v)}\n" for k, v in sensor.items())
 
 
 def toml_value(value) -> str:

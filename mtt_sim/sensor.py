@@ -203,9 +203,9 @@ class _Memory:
     def recall(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(known, state, drift, outlier offsets, ease) for each id; unknown ids get MISSED and zeros."""
         row = _rows_of(self.ids, ids)
-        known, r = row >= 0, np.maximum(row, 0)
-        values = np.where(known[:, None], self.values[r], 0.0) if len(self.ids) else np.zeros((len(ids), 9))
-        state = np.where(known, self.state[r], MISSED) if len(self.ids) else np.full(len(ids), MISSED, np.int8)
+        known = row >= 0
+        values, state = np.zeros((len(ids), 9)), np.full(len(ids), MISSED, np.int8)
+        values[known], state[known] = self.values[row[known]], self.state[row[known]]
         return known, state, values[:, :4], values[:, 4:8], values[:, 8]
 
     def store(self, ids: np.ndarray, state: np.ndarray, drift: np.ndarray, poor: np.ndarray, ease: np.ndarray) -> None:
@@ -373,8 +373,9 @@ class SyntheticSensor(Sensor):
         scaled = np.concatenate([boxes[:, :2] + (boxes[:, 2:] - wh) / 2, wh], axis=1)
         offsets = drift + self._frame_noise(len(boxes), centre, size)
         if whole.any():
-            offsets[whole] = offsets_in_band(boxes[whole], scaled[whole], drift[whole], np.array([centre, centre, size, size]),
-                                             TRUE_BAND, self.rng, np.zeros_like(drift[whole]))
+            offsets[whole] = offsets_in_band(boxes[whole], scaled[whole], drift[whole],
+                                             np.array([centre, centre, size, size]), TRUE_BAND, self.rng,
+                                             np.zeros_like(drift[whole]))
         return displace(scaled, offsets)
 
     def _frame_noise(self, n: int, centre: float, size: float) -> np.ndarray:

@@ -94,7 +94,7 @@ def twin_fingerprint(folder, sensor_file, seed):
 @pytest.fixture(scope="module")
 def sensor_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("sensor") / "fitted.toml"
-    path.write_text("[sensor]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in KNOWN.items()) + "\n")
+    path.write_text(calibrate.sensor_toml(KNOWN))
     return path
 
 

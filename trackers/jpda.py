@@ -302,8 +302,9 @@ class Jpda(Tracker):
         keeper = np.zeros(len(occluded), bool)
         keeper[order[first]] = True  # the elder of each blob stays
         p = self.params
-        duplicate = (self.age[occluded] < p["vanish_frames"]) | \
-            (not newborn_only) & (self.together[occluded] >= p["merge_frames"])
+        duplicate = self.age[occluded] < p["vanish_frames"]
+        if not newborn_only:
+            duplicate |= self.together[occluded] >= p["merge_frames"]
         dropped = duplicate & ~keeper
         keep = np.ones(len(self.ids), bool)
         keep[occluded[dropped]] = False

@@ -43,12 +43,12 @@ def main():
         keys = shifted(base, d)
         ap = mot17_like_ap(keys)
         print(f"{name}: d = {d:+.3f}, pd {keys['pd']:.4f}: average precision on mot17_like {ap:.3f} (published {target})")
-        head = (f"# The {name.upper()} detector of MOT17 (average precision {target} on MOT17Det): mot15_frcnn with "
-                f"P(detect) shifted by\n# d = {d:+.3f} on the logit scale, so that its average precision over "
-                f"mot17_like's people is {ap:.3f},\n# and its confidences spread over [0, 1]. Written by "
-                "docs/experiments/fit_presets.py.\n")
-        (DETECTORS / f"{name}.toml").write_text(head + "[sensor]\n" + "".join(
-            f"{k} = {calibrate.toml_value(round(v, 4) if isinstance(v, float) else v)}\n" for k, v in keys.items()))
+        comments = [f"The {name.upper()} detector of MOT17 (average precision {target} on MOT17Det): mot15_frcnn with "
+                    "P(detect) shifted by",
+                    f"d = {d:+.3f} on the logit scale, so that its average precision over mot17_like's people is {ap:.3f},",
+                    "and its confidences spread over [0, 1]. Written by docs/experiments/fit_presets.py."]
+        rounded = {k: round(v, 4) if isinstance(v, float) else v for k, v in keys.items()}
+        (DETECTORS / f"{name}.toml").write_text(calibrate.sensor_toml(rounded, comments))
 
 
 if __name__ == "__main__":
