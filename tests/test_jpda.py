@@ -115,12 +115,16 @@ def test_situations_from_beta_prime():
 
 
 def frames(paths, k_max):
-    """Observations from per-target centre paths (None = not detected that frame); boxes 10 x 20."""
+    """Observations from per-target paths of centres (x, y), boxes 10 x 20, or (x, y, w, h); None = not detected."""
     for k in range(k_max):
-        rows = [(x - 5, y - 10, 10, 20, 0.9) for p in paths if (c := p(k)) is not None for x, y in [c]]
+        rows = [(x - w / 2, y - h / 2, w, h, 0.9) for p in paths if (c := p(k)) is not None
+                for x, y, w, h in [tuple(c) + (10, 20)[len(c) - 2:]]]
         dets = np.zeros((8, 5), np.float32)
         dets[: len(rows)] = np.array(rows, np.float32).reshape(-1, 5)
         yield {"detections": dets, "num_detections": len(rows)}
+
+
+PAPER = {"min_hits": 1, "coast": False, "early_duplicates": False, "blob_report": "all"}  # its track management
 
 
 def run(paths, k_max, **params):
@@ -131,7 +135,7 @@ def run(paths, k_max, **params):
 
 def test_new_then_normal_then_vanished_and_ended_after_three_misses():
     a = lambda k: (20 + 2 * k, 50) if k < 10 else None  # noqa: E731
-    t, out = run([a], 16)
+    t, out = run([a], 16, **PAPER)
     assert out[0] == ([1], [NEW]) and out[5] == ([1], [NORMAL])
     assert [o[1] for o in out[10:13]] == [[VANISHED]] * 3 and all(o[0] == [] for o in out[10:])
     assert len(t.ids) == 0 and t.ended["ids"].tolist() == [1]
@@ -139,7 +143,7 @@ def test_new_then_normal_then_vanished_and_ended_after_three_misses():
 
 def test_a_confirmed_target_stays_confirmed_through_a_miss():
     a = lambda k: (20 + 2 * k, 50) if k != 10 else None  # noqa: E731 (one missed detection)
-    _, out = run([a], 14, min_hits=3)
+    _, out = run([a], 14, min_hits=3, coast=False)
     assert [o[0] for o in out[:4]] == [[], [], [1], [1]]  # confirmed at its third frame
     assert out[10][0] == [] and out[11][0] == [1]  # not re-counted: back at once after the miss
 
@@ -148,7 +152,7 @@ def test_with_coast_a_confirmed_target_is_reported_while_missed_until_it_vanishe
     a = lambda k: (20 + 2 * k, 50) if k < 10 else None  # noqa: E731
     _, out = run([a], 15, min_hits=3, coast=True)
     assert [o[0] for o in out[10:15]] == [[1], [1], [], [], []]  # coasts 2 frames, ended at the third miss
-    _, out = run([a], 15, min_hits=3)
+    _, out = run([a], 15, min_hits=3, coast=False)
     assert [o[0] for o in out[10:15]] == [[]] * 5  # the paper's: only targets with a measurement this frame
 
 
@@ -156,9 +160,9 @@ def test_with_coast_a_confirmed_target_is_reported_while_missed_until_it_vanishe
 def test_a_duplicate_born_beside_its_target_does_not_cost_the_target_its_id(fix):
     a = lambda k: (20 + 5 * k, 50)  # noqa: E731
     dup = lambda k: (20 + 5 * k, 56) if k == 15 else None  # noqa: E731 (one stray detection, just outside the gate)
-    _, out = run([a, dup], 30, meas_sigma=1.0)
+    _, out = run([a, dup], 30, meas_sigma=1.0, **PAPER)
     assert out[17][1] == [OCCLUDED, OCCLUDED] and out[-1][0] == [3]  # the paper's rule: snapped at rest, then lost
-    _, out = run([a, dup], 30, meas_sigma=1.0, **fix)
+    _, out = run([a, dup], 30, meas_sigma=1.0, **PAPER | fix)
     assert out[15][0] == [1, 2] and all(o[0] == [1] for o in out[16:])
 
 
@@ -171,7 +175,7 @@ def test_a_target_reappearing_soon_is_revived_with_its_id():
 
 def test_a_target_reappearing_too_late_is_new():
     a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 20 else None  # noqa: E731
-    t, out = run([a], 24)
+    t, out = run([a], 24, **PAPER)
     assert out[20][0] == [2] and out[20][1] == [NEW]
 
 
@@ -186,7 +190,7 @@ def test_fragments_of_one_target_are_a_split_and_update_it():
 def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
     a = lambda k: (20 + 2 * k, 50) if k < 8 else (None if k < 12 else (20 + 2 * k, 50))  # noqa: E731
     b = lambda k: (20 + 2 * k, 80) if k < 8 else ((20 + 2 * k, 65) if k < 12 else (20 + 2 * k, 80))  # noqa: E731
-    t, out = run([a, b], 9, meas_sigma=8.0)  # the paper's rule: at the blob, at rest
+    t, out = run([a, b], 9, meas_sigma=8.0, **PAPER)  # the paper's rule: at the blob, at rest
     assert out[8][1] == [OCCLUDED, OCCLUDED] and sorted(out[8][0]) == [1, 2]
     np.testing.assert_allclose(t.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
     np.testing.assert_allclose(t.kf.x[:, 2:], 0.0)
@@ -234,6 +238,19 @@ def test_occlusion_merge_then_separation_keeps_ids():
     assert owner == {1: {"a"}, 2: {"b"}}, owner
 
 
+@pytest.mark.parametrize("blob, reported", [((10, 20), [[1]] * 3), ((20, 20), [[1, 2]] * 3)])
+def test_a_merged_blob_reports_as_many_targets_as_its_box_holds(blob, reported):
+    """Issue 15, cause 5: two targets merge into one detection for frames 9-11. A blob the size of one target
+    reports one (the elder), a blob twice that size both; either way both come out with their ids."""
+    paths, a, b = crossing_paths()
+    paths[0] = lambda k: a(k) if k not in range(9, 12) else ((a(k)[0] + b(k)[0]) / 2, 54) + blob
+    for params, expected in [({}, reported), ({"blob_report": "all"}, [[1, 2]] * 3)]:  # all: the paper's
+        t = trackers.make("jpda", occlusion_velocity="keep", **params)
+        t.reset({})
+        out = [sorted(t.update(obs).ids.tolist()) for obs in frames(paths, 16)]
+        assert out[9:12] == expected and out[8] == out[12] == out[15] == [1, 2]
+
+
 def test_bad_occlusion_velocity():
     with pytest.raises(ValueError, match="occlusion_velocity='stop': allowed: 'keep', 'zero'"):
         trackers.make("jpda:occlusion_velocity=stop")
@@ -243,5 +260,5 @@ def test_a_duplicate_sharing_one_blob_for_long_is_dropped():
     """Two targets that sit in one blob for merge_frames frames are one object: the younger goes."""
     a = lambda k: (20 + 2 * k, 50) if k < 3 else (20 + 2 * k, 54)  # noqa: E731
     b = lambda k: (20 + 2 * k, 58) if k < 3 else None  # noqa: E731  (merged into a's blob from frame 3 on)
-    t, out = run([a, b], 30, meas_sigma=6.0, merge_frames=10)
+    t, out = run([a, b], 30, meas_sigma=6.0, merge_frames=10, **PAPER)
     assert out[5][1] == [OCCLUDED, OCCLUDED] and len(t.ids) == 1 and out[-1][0] == [1]

@@ -141,16 +141,29 @@ class Jpda(Tracker):
     occluded targets jump to the shared measurement with zero velocity; a target vanished for vanish_frames frames is
     ended but can be revived by a new measurement within revive_frames; other unexplained measurements start
     targets at rest. Boxes take the size of the most probable measurement of a normal or new target, else their
-    last size. Reported: confirmed targets (once they have had a measurement min_hits frames in a row; 1 in the
-    paper, which reports every new target at once) that had a measurement this frame, or, with coast=true, that
-    have not yet vanished (their prediction, as Stone Soup reports tracks). situations=false drops the occlusion correction, the separation,
-    the duplicate rule and the revival (plain JPDA with births and deaths); occlusion_velocity=keep keeps each
-    occluded target's velocity (the paper zeroes it); occlusion_covariance=full restarts the velocity's covariance
-    with the zeroed velocity (position: only the position's, as before); early_duplicates=true drops a newborn
-    duplicate sharing a blob with its elder before the situations are classified, so the elder is not snapped to
-    the blob (false: afterwards, as before); k=0 means the paper's K. Deviations from the paper,
-    each a gap it leaves open: merged targets coming apart take one measurement each from the best joint event;
-    duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped."""
+    last size. situations=false drops the occlusion correction, the separation, the duplicate rule and the revival
+    (the paper's traditional JPDA, with births and deaths); k=0 means the paper's K.
+
+    Gaps the paper leaves open, filled here: merged targets coming apart take one measurement each from the best
+    joint event; duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped.
+
+    Track management that departs from the paper (issue 15), each a parameter whose other value is the paper's:
+    min_hits=3 reports a target once it has had a measurement 3 frames in a row, and from then on (1: at once);
+    coast=true reports a confirmed target through its misses at its prediction until it vanishes, as Stone Soup
+    does (false: only in frames with a measurement); early_duplicates=true drops a newborn duplicate sharing a blob
+    with its elder before the situations are read, so the elder is not snapped to the blob (false: afterwards);
+    blob_report=size reports, of the targets merged into one blob, only as many as its box holds people: the
+    blob's area over the mean of its members' own last areas, rounded, at least one; the eldest are reported and
+    the rest tracked unseen until the blob separates (all: every member). This reads section 5's merge as the
+    paper draws it: merged targets share one state at the blob, and only the best joint event at separation says
+    who leaves as whom, so a blob is evidence of the people it can hold, not of every track that touched it. occlusion_velocity=keep keeps an occluded target's velocity (zero: the paper);
+    occlusion_covariance=full restarts the velocity's covariance with the zeroed velocity (position: only the
+    position's). The paper's track management: min_hits=1,coast=false,early_duplicates=false,blob_report=all.
+
+    Units: pixels and frames. meas_sigma is the standard deviation of a detection centre (px), accel_sigma that of
+    a white acceleration per frame (px/frame^2; its velocity variance per frame is accel_sigma^2, so Stone Soup's
+    ConstantVelocity(q) is accel_sigma = sqrt(q)), speed_sigma0 a new target's velocity spread (px/frame);
+    clutter_density is false detections per px^2 per frame, pd the detection probability."""
 
     name = "jpda"
     description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
@@ -159,8 +172,9 @@ class Jpda(Tracker):
                   "revive_frames": Param(5, "[0, inf)"), "accel_sigma": Param(0.5, "[0, inf)"),
                   "meas_sigma": Param(4.0, "(0, inf)"), "min_confidence": Param(0.0), "situations": Param(True),
                   "occlusion_velocity": Param("zero", ("keep", "zero")), "speed_sigma0": Param(2.0, "(0, inf)"),
-                  "min_hits": Param(1, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(False),
-                  "early_duplicates": Param(False), "occlusion_covariance": Param("position", ("position", "full"))}
+                  "min_hits": Param(3, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(True),
+                  "early_duplicates": Param(True), "occlusion_covariance": Param("position", ("position", "full")),
+                  "blob_report": Param("size", ("all", "size"))}
 
     def reset(self, info=None):
         p = self.params
@@ -212,12 +226,14 @@ class Jpda(Tracker):
                 self.kf.P[occluded, 2:, 2:] = self.model.P0[2:, 2:]
         self.kf.P[occluded, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
         self.kf.P[occluded, :2, 2:] = self.kf.P[occluded, 2:, :2] = 0.0
+        hidden = self._surplus(occluded, best[occluded], dets) if p["blob_report"] == "size" else occluded[:0]
         sized = np.flatnonzero((kind == NORMAL) | (kind == SEPARATED))
         self.sizes[sized] = dets[best[sized], 2:4]
         self.misses = np.where(kind == VANISHED, self.misses + 1, 0)
         own = (kind == NORMAL) | (kind == SEPARATED) | (kind == SPLIT)  # a miss says nothing either way
         self.together = np.where(own, 0, self.together + (kind == OCCLUDED))
         self.age += 1
+        hidden_ids = self.ids[hidden]
         if p["situations"]:
             self._drop_duplicates(situ, best)
         self._end_vanished()
@@ -227,6 +243,7 @@ class Jpda(Tracker):
         self.hits = np.where(self.misses == 0, self.hits + 1, 0)
         self.confirmed |= self.hits >= p["min_hits"]  # once: a confirmed target stays confirmed through its misses
         seen = self.confirmed & ((self.misses == 0) | p["coast"])
+        seen[np.isin(self.ids, hidden_ids)] = False
         centre = self.kf.x[seen, :2]
         return Tracks.of(self.ids[seen], np.c_[centre - self.sizes[seen] / 2, self.sizes[seen]])
 
@@ -288,6 +305,15 @@ class Jpda(Tracker):
         P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
         self.kf.P = (P + P.transpose(0, 2, 1)) / 2  # keep it symmetric against rounding
 
+    def _by_blob(self, occluded: np.ndarray, blob: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Occluded targets (rows) and their blobs (measurements) ordered by blob, then eldest, then lowest id, the
+        index of each blob's first, and each target's rank in its blob (0 the eldest)."""
+        order = np.lexsort((self.ids[occluded], -self.age[occluded], blob))
+        blob = blob[order]
+        starts = np.flatnonzero(np.r_[True, blob[1:] != blob[:-1]])
+        rank = np.arange(len(blob)) - np.repeat(starts, np.diff(np.r_[starts, len(blob)]))
+        return occluded[order], blob, starts, rank
+
     def _drop_duplicates(self, situ: list[str], best: np.ndarray, newborn_only: bool = False) -> bool:
         """Targets occluded together with an older one are dropped when they are younger than vanish_frames (a
         fragment or a clutter blob beside it) or, unless newborn_only, have shared its blob for merge_frames frames
@@ -296,20 +322,27 @@ class Jpda(Tracker):
         occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
         if len(occluded) < 2:
             return False
-        blob = best[occluded]
-        order = np.lexsort((self.ids[occluded], -self.age[occluded], blob))  # by blob, then oldest, then lowest id
-        first = np.r_[True, blob[order][1:] != blob[order][:-1]]
-        keeper = np.zeros(len(occluded), bool)
-        keeper[order[first]] = True  # the elder of each blob stays
+        occluded, _, _, rank = self._by_blob(occluded, best[occluded])
         p = self.params
         duplicate = self.age[occluded] < p["vanish_frames"]
         if not newborn_only:
             duplicate |= self.together[occluded] >= p["merge_frames"]
-        dropped = duplicate & ~keeper
+        dropped = duplicate & (rank > 0)  # the elder of each blob stays
         keep = np.ones(len(self.ids), bool)
         keep[occluded[dropped]] = False
         self._keep(keep)
         return bool(dropped.any())
+
+    def _surplus(self, occluded: np.ndarray, blob: np.ndarray, dets: np.ndarray) -> np.ndarray:
+        """The occluded targets a merged blob has no room for (blob_report=size): beyond the eldest round(blob's
+        area / mean of its members' own last areas), at least one."""
+        if not len(occluded):
+            return occluded
+        occluded, blob, starts, rank = self._by_blob(occluded, blob)
+        members = np.diff(np.r_[starts, len(occluded)])
+        mean_area = np.add.reduceat(self.sizes[occluded].prod(axis=1), starts) / members
+        room = np.maximum(1, np.floor(dets[blob[starts], 2:4].prod(axis=1) / np.maximum(mean_area, 1e-9) + 0.5))
+        return occluded[rank >= np.repeat(room, members)]
 
     def _end_vanished(self) -> None:
         """Targets vanished for vanish_frames frames leave the active set for the revival pool."""
