@@ -124,7 +124,8 @@ def frames(paths, k_max):
         yield {"detections": dets, "num_detections": len(rows)}
 
 
-PAPER = {"min_hits": 1, "coast": False, "early_duplicates": False, "blob_report": "all"}  # its track management
+PAPER = {"min_hits": 1, "coast": False, "early_duplicates": False, "blob_report": "all",  # its track management
+         "merge_needs_overlap": False}
 
 
 def run(paths, k_max, **params):
@@ -194,6 +195,18 @@ def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
     assert out[8][1] == [OCCLUDED, OCCLUDED] and sorted(out[8][0]) == [1, 2]
     np.testing.assert_allclose(t.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
     np.testing.assert_allclose(t.kf.x[:, 2:], 0.0)
+
+
+def test_two_targets_apart_sharing_one_measurement_are_not_merged():
+    """One detection between two targets whose boxes do not touch (the other detection missed) is no merge: the
+    JPDA update stands and both keep their velocities (the paper's rule snaps both to it, at rest)."""
+    a = lambda k: (20 + 2 * k, 50) if k != 8 else None  # noqa: E731
+    b = lambda k: (20 + 2 * k, 80) if k != 8 else (36, 65)  # noqa: E731
+    t, out = run([a, b], 9, meas_sigma=8.0)
+    assert out[8][1] == [NORMAL, NORMAL] and sorted(out[8][0]) == [1, 2]
+    assert (np.abs(t.kf.x[:, 2]) > 1).all()
+    t, out = run([a, b], 9, meas_sigma=8.0, merge_needs_overlap=False)
+    assert out[8][1] == [OCCLUDED, OCCLUDED]
 
 
 def test_jpda_exact_uses_every_joint_event():

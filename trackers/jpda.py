@@ -156,9 +156,14 @@ class Jpda(Tracker):
     blob's area over the mean of its members' own last areas, rounded, at least one; the eldest are reported and
     the rest tracked unseen until the blob separates (all: every member). This reads section 5's merge as the
     paper draws it: merged targets share one state at the blob, and only the best joint event at separation says
-    who leaves as whom, so a blob is evidence of the people it can hold, not of every track that touched it. occlusion_velocity=keep keeps an occluded target's velocity (zero: the paper);
-    occlusion_covariance=full restarts the velocity's covariance with the zeroed velocity (position: only the
-    position's). The paper's track management: min_hits=1,coast=false,early_duplicates=false,blob_report=all.
+    who leaves as whom, so a blob is evidence of the people it can hold, not of every track that touched it.
+    merge_needs_overlap=true classes targets sharing one measurement as occluded only where their predicted boxes
+    overlap: apart, one measurement for two is a missed detection and the JPDA update stands (false: the paper's,
+    any shared sole measurement is a merge). Not departures, but choices the paper does not make:
+    occlusion_velocity=keep keeps an occluded target's velocity (zero: the paper's); occlusion_covariance=full
+    restarts the velocity's covariance with the zeroed velocity (position: only the position's, the default).
+    The paper's track management is
+    min_hits=1,coast=false,early_duplicates=false,blob_report=all,merge_needs_overlap=false.
 
     Units: pixels and frames. meas_sigma is the standard deviation of a detection centre (px), accel_sigma that of
     a white acceleration per frame (px/frame^2; its velocity variance per frame is accel_sigma^2, so Stone Soup's
@@ -174,7 +179,7 @@ class Jpda(Tracker):
                   "occlusion_velocity": Param("zero", ("keep", "zero")), "speed_sigma0": Param(2.0, "(0, inf)"),
                   "min_hits": Param(3, "[1, inf)"), "merge_frames": Param(40, "[1, inf)"), "coast": Param(True),
                   "early_duplicates": Param(True), "occlusion_covariance": Param("position", ("position", "full")),
-                  "blob_report": Param("size", ("all", "size"))}
+                  "blob_report": Param("size", ("all", "size")), "merge_needs_overlap": Param(True)}
 
     def reset(self, info=None):
         p = self.params
@@ -207,6 +212,8 @@ class Jpda(Tracker):
                 self._drop_duplicates(situ, np.argmax(beta[:, 1:], axis=1), newborn_only=True):
             beta, gated, g = self._associate(z)  # without the newborn duplicates: the elder is not snapped
             situ, unexplained = situations(beta[:, 1:].T)
+        if p["situations"] and p["merge_needs_overlap"]:
+            self._apart_is_not_merged(situ, np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int))
         if p["situations"]:
             self._separate(situ, beta, g)
         self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": self.ids.copy(),
@@ -270,6 +277,18 @@ class Jpda(Tracker):
             beta[ti, 0] = b[:, 0]
             beta[np.ix_(ti, zj + 1)] = b[:, 1:]
         return beta, gated, g
+
+    def _apart_is_not_merged(self, situ: list[str], best: np.ndarray) -> None:
+        """Occluded targets whose predicted boxes overlap no other target of their blob are not merged: one
+        measurement for two targets apart is a missed detection, and the JPDA update stands (NORMAL)."""
+        occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
+        if len(occluded) < 2:
+            return
+        centre, half = self.kf.x[occluded, :2], self.sizes[occluded] / 2
+        apart = (np.abs(centre[:, None] - centre[None]) >= half[:, None] + half[None]).any(axis=2)
+        touching = (~apart & (best[occluded][:, None] == best[occluded][None])).sum(axis=1) > 1  # itself too
+        for t in occluded[~touching]:
+            situ[t] = NORMAL
 
     def _separate(self, situ: list[str], beta: np.ndarray, g: np.ndarray) -> None:
         """Targets that shared a blob last frame and now see several measurements take one each, from the most
