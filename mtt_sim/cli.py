@@ -372,8 +372,8 @@ def cmd_trackers(args) -> int:
 
     for name, cls in sorted(trackers.base.REGISTRY.items()):
         print(f"{name}: {cls.description}")
-        for key, param in cls.parameters.items():
-            print(f"    {key + '=' + repr(param.default):34s} {param.allowed_text()}")
+        for line in trackers.base.describe(name):
+            print("    " + line)
     return 0
 
 

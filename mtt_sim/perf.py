@@ -178,6 +178,7 @@ def report_jpda(rows: list[dict]) -> str:
     out = ["jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
            "| targets | jpda ms/frame | gnn ms/frame | jpda / gnn |", "|---:|---:|---:|---:|"]
     out += [f"| {r['targets']} | {r['jpda_ms']:.2f} | {r['gnn_ms']:.2f} | {r['jpda_over_gnn']:.2f}x |" for r in rows]
+    out += ["jpda's parameters (its defaults, as measured):"] + ["    " + line for line in trackers.base.describe("jpda")]
     return "\n".join(out)
 
 

@@ -155,6 +155,7 @@ def test_trackers_lists_every_tracker_with_its_parameters(capsys):
     for name in trackers.available():
         assert f"\n{name}: " in "\n" + out
     assert "max_age=1" in out and "an integer in [0, inf)" in out and "'keep', 'zero'" in out
+    assert "meas_sigma=4.0                     a number in (0, inf); detection centre noise, px" in out  # its unit
 
 
 def test_an_existing_output_is_refused_unless_forced(tmp_path, capsys):

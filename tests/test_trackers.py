@@ -279,6 +279,20 @@ def test_murty_matches_brute_force_enumeration(cost, k):
         assert len(set(cols.tolist())) == n and cost[np.arange(n), cols].sum() == pytest.approx(total)
 
 
+def test_murty_keeps_about_k_subproblems_not_k_times_rows():
+    """A crowd's cluster (40 targets, 80 columns, K = 120): every popped solution opens up to 40 subproblems of
+    25.6 KB each, 120 MB if all were kept; only those that can still be among the k best are."""
+    import tracemalloc
+
+    cost = np.random.default_rng(0).exponential(1.0, (40, 80))
+    tracemalloc.start()
+    got = murty(cost, 120)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    totals = [total for _, total in got]
+    assert len(got) == 120 and totals == sorted(totals) and peak < 15e6
+
+
 def test_murty_edge_cases():
     assert murty(np.array([[np.inf, np.inf]]), 3) == []
     assert murty(np.zeros((0, 2)), 2)[0][1] == 0.0

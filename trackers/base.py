@@ -108,6 +108,7 @@ class Param:
 
     default: Any
     allowed: str | tuple[str, ...] | None = None
+    meaning: str = ""  # what it is, with its unit
 
     def __post_init__(self):
         if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
@@ -212,6 +213,13 @@ def register(cls):
 def available() -> dict[str, str]:
     """Registered tracker names with their one-line descriptions."""
     return {name: cls.description for name, cls in sorted(REGISTRY.items())}
+
+
+def describe(name: str) -> list[str]:
+    """A registered tracker's parameters, a line each: name=default, the allowed values and what it means."""
+    return [f"{key + '=' + repr(param.default):34s} {param.allowed_text()}" + (f"; {param.meaning}" if param.meaning
+                                                                               else "")
+            for key, param in REGISTRY[name].parameters.items()]
 
 
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
