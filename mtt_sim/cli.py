@@ -234,21 +234,27 @@ def _require(module: str, argument: str, extra: str) -> None:
 def cmd_run(args) -> int:
     overrides = _overrides(args)
     _loaded([args.scenario], overrides)
-    video = _output(args.video, args.force, "--video", (".mp4", ".avi"))
+    video = _output(args.video, args.force, "--video", (".mp4", ".gif"))
     results = _output(args.results, args.force, "--results", (".txt",))
+    if args.compare and args.results:
+        raise UsageError("--results", "a results file takes one tracker: leave out --compare")
+    specs = args.compare or [args.tracker]
     from . import experiment
 
-    record = experiment.run_episode(args.scenario, args.tracker, args.seed, overrides, results=args.results,
-                                    video=args.video, steps=args.steps, progress=True)
-    metrics = record["metrics"] or {"metrics": "none: the sequence has no gt/gt.txt"}
-    summary = {"scenario": args.scenario, "tracker": args.tracker, "seed": args.seed,
-               **{k: metrics[k] for k in SUMMARY_KEYS if k in metrics}, **({} if record["metrics"] else metrics),
-               "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
+    records = experiment.run_episodes(args.scenario, specs, args.seed, overrides, video=args.video, steps=args.steps,
+                                      progress=True, scale=args.scale, results=args.results)
+    for record in records:
+        metrics = record["metrics"] or {"metrics": "none: the sequence has no gt/gt.txt"}
+        summary = {"scenario": args.scenario, "tracker": record["tracker"], "seed": args.seed,
+                   **{k: metrics[k] for k in SUMMARY_KEYS if k in metrics}, **({} if record["metrics"] else metrics),
+                   "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
+        if args.json:
+            print(json.dumps(summary))
+            continue
+        for k, v in summary.items():
+            print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
     if args.json:
-        print(json.dumps(summary))
         return 0
-    for k, v in summary.items():
-        print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
     for name, path in (("video", video), ("results", results)):
         if path:
             print(f"{name:12s} {path}" + (" (replaced)" if args.force else ""))
@@ -519,7 +525,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=_integer(0), default=0, help="episode seed, >= 0 (default 0)")
     run.add_argument("--steps", type=_integer(1), default=None, help="at most this many steps (default: the "
                                                                         "scenario's env.max_steps)")
-    run.add_argument("--video", help="write an annotated video (.mp4 or .avi)")
+    run.add_argument("--video", help="write an annotated video: .mp4 (H.264) or .gif")
+    run.add_argument("--compare", type=_tracker_specs, help="several trackers on the same episode, one video panel each, side by side "
+                                       "(comma-separated specs, or ';'-separated: 'sort;jpda:coast=false')")
+    run.add_argument("--scale", type=_integer(1, 8), default=1, help="enlarge the video's frames this many "
+                                                                     "times (1 to 8; for small scenes)")
     run.add_argument("--results", help="write the tracks as a MOTChallenge results file (.txt; an offline method's "
                                        "offline output)")
     run.add_argument("--force", action="store_true", help=force_help)

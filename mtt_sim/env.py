@@ -22,7 +22,7 @@ from . import viewer
 from .scenario import is_sequence
 from .sequence import Recording
 from .metrics import EpisodeMetrics, FrameStats
-from .overlay import draw_overlay
+from .overlay import draw_banner, draw_debug, draw_legend, draw_overlay, running_metrics
 from .render import Renderer
 from .sensor import Detections, SyntheticSensor, make_sensor
 from .truth import Truth, measure
@@ -78,7 +78,11 @@ class TrackingEnv(gym.Env):
 
     def __init__(self, scenario: str | os.PathLike | scn.Scenario | None = "crossing", config: Mapping | None = None,
                  render_mode: str | None = None, obs_mode: str | None = None, sequence: str | os.PathLike | None = None,
-                 benchmark: str | None = None, sensor: str | os.PathLike | None = None):
+                 benchmark: str | None = None, sensor: str | os.PathLike | None = None, render_scale: int = 1):
+        if not isinstance(render_scale, (int, np.integer)) or isinstance(render_scale, bool) or not 1 <= render_scale <= 8:
+            raise ValueError(f"render_scale={render_scale!r}: allowed: an integer from 1 to 8 (how many times render() "
+                             "enlarges the frame)")
+        self.render_scale = int(render_scale)
         overrides = scn.expand_dotted(config or {})
         if sensor is not None:  # a fitted detector's file; keys in `config` win
             overrides = scn.merge(scn.read_sensor(sensor), overrides)
@@ -170,6 +174,8 @@ class TrackingEnv(gym.Env):
         self._trails: dict[int, deque] = {}
         self._remembered_at = -1
         self._last_tracks = (np.zeros(0, np.int64), np.zeros((0, 4)))
+        self._answered: tuple | None = None  # what render() draws: the frame the last tracks answer
+        self._idf1: tuple[int, float | None] = (0, None)
         obs = self.observe()
         if self.recording is None:
             seen = self.truth.visibility > 0
@@ -319,14 +325,20 @@ class TrackingEnv(gym.Env):
             raise ActionError(f"action['ids'] must be unique within a frame; repeated: {uniq[counts > 1].tolist()}")
         return ids.astype(np.int64), boxes
 
-    def remember_tracks(self, ids, boxes):
-        """The tracks to draw on the current frame, and their trails (step() records its action's tracks
-        itself, unless they were given here first for this frame, e.g. to render before stepping)."""
+    def remember_tracks(self, ids, boxes, debug: list[dict] | None = None, name: str | None = None):
+        """Hand the env the tracks answering the current frame, with the tracker's `debug()` drawings and its name,
+        for render() to draw on this frame (and record their trails). step() records its action's tracks itself,
+        unless they were given here first for this frame: an agent that wants its drawings in `render()` or
+        Gymnasium's RecordVideo calls `env.unwrapped.remember_tracks(tracks.ids, tracks.boxes, tracker.debug(),
+        "name")` before `env.step(action)`. render() then shows the frame they answered until the next step."""
         if self._remembered_at == self.steps:
             return
         self._remembered_at = self.steps
         ids, boxes = np.asarray(ids, np.int64), np.asarray(boxes, float).reshape(-1, 4)
         self._last_tracks = (ids, boxes)
+        if self.render_mode is not None:
+            self._answered = (self.frame.copy(), self.truth, self.detections.rows.copy(), self.steps, list(debug or []),
+                              name)
         centres = boxes[:, :2] + boxes[:, 2:] / 2
         for i, c in zip(ids.tolist(), centres):
             self._trails.setdefault(i, deque(maxlen=_TRAIL)).append(c)
@@ -337,18 +349,35 @@ class TrackingEnv(gym.Env):
     # ------------------------------------------------------------ rendering
 
     def render(self):
-        """rgb_array: the frame with ground truth, detections and the last tracks drawn on; human: show it in a window
-        (which reset and step also do)."""
+        """rgb_array: the frame the last tracks answered (the current one before any), enlarged render_scale times,
+        with ground truth, detections, the tracks and any drawings their tracker handed over, a banner (frame,
+        tracker, running MOTA / IDF1 / FP / FN / IDSW; IDF1 refreshed once a second of video) and a legend; human:
+        show it in a window (which reset and step also do)."""
         if not self._started:
             raise RuntimeError("render() needs reset() first")
         if self.render_mode is None:
             gym.logger.warn("render() called with render_mode=None; make the env with render_mode='rgb_array'")
             return None
-        img = draw_overlay(self.frame, self.truth, self.detections.rows, *self._last_tracks, self._trails)
+        frame, truth, dets, index, debug, name = self._answered or (self.frame, self.truth, self.detections.rows,
+                                                                    self.steps, [], None)
+        tracks = self._last_tracks if self._answered else (np.zeros(0, np.int64), np.zeros((0, 4)))
+        img = draw_overlay(frame, truth, dets, *tracks, self._trails, self.render_scale)
+        draw_debug(img, debug, self.render_scale)
+        m = self.metrics
+        banner = f"frame {index}" + (f"  {name}" if name else "") + "  " + running_metrics(
+            m.tp, m.fp, m.fn, m.idsw, self._running_idf1())
+        draw_legend(draw_banner(img, banner))
         if self._viewer:
             self._viewer.show(img)
             return None
         return img
+
+    def _running_idf1(self) -> float | None:
+        """IDF1 so far, recomputed once per render_fps scored frames (it needs a global assignment)."""
+        frames = len(self.metrics)
+        if frames and (frames - self._idf1[0] >= self.metadata["render_fps"] or self._done):
+            self._idf1 = (frames, self.metrics.summary()["IDF1"])
+        return self._idf1[1]
 
     def close(self):
         if self._viewer:

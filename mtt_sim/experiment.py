@@ -28,53 +28,86 @@ from . import pool
 from .env import TrackingEnv
 from .metrics import METRICS, PER_TARGET
 from .motchallenge import write_results
-from .overlay import VideoWriter, draw_debug
+from .overlay import VideoWriter
 
 BACKENDS = ("local", "ray")
+
+
+class _Episode:
+    """One tracker running on its own env: the agent, the env, the tracks it reported and its timers."""
+
+    def __init__(self, scenario: str, tracker: str, seed: int, config: Mapping | None, render: bool, scale: int):
+        self.tracker, self.agent = tracker, trackers.make(tracker)
+        self.env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if render else None,
+                               obs_mode="frame+detections" if self.agent.needs_frame else "detections",
+                               render_scale=scale)
+        self.obs, info = self.env.reset(seed=seed)
+        self.agent.reset(info)
+        self.online: list[trackers.Tracks] = []
+        self.tracker_time = self.env_time = 0.0
+        self.done = False
+
+    def step(self, render: bool) -> np.ndarray | None:
+        """Answer the current frame and advance; with render, the annotated frame that was answered."""
+        start = time.perf_counter()
+        tracks = self.agent.update(self.obs)
+        mid = time.perf_counter()
+        action = tracks.to_action(self.env.action_space)
+        n = action["num_tracks"]
+        self.online.append(trackers.Tracks.of(action["ids"][:n], action["boxes"][:n]))
+        img = None
+        if render:
+            self.env.remember_tracks(tracks.ids, tracks.boxes, self.agent.debug(), self.tracker)
+            img = self.env.render()
+        self.obs, _, terminated, truncated, _ = self.env.step(action)
+        self.tracker_time, self.env_time = self.tracker_time + mid - start, self.env_time + time.perf_counter() - mid
+        self.done = terminated or truncated
+        return img
+
+    def record(self, scenario: str, seed: int, config: Mapping | None) -> dict:
+        env, frames = self.env, len(self.online)
+        scored = env.recording is None or env.recording.scored
+        return {"tracker": self.tracker, "params": self.agent.params, "scenario": str(scenario), "seed": seed,
+                "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
+                "per_target": env.metrics.per_target() if scored else {},
+                "tracker_fps": frames / max(self.tracker_time, 1e-9), "env_fps": frames / max(self.env_time, 1e-9)}
+
+
+def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Mapping | None = None,
+                 video: str | None = None, steps: int | None = None, progress: bool = False, scale: int = 1,
+                 results: str | None = None) -> list[dict]:
+    """One episode of each tracker in `specs` on `scenario` (a shipped key, a .toml file or a recorded sequence's
+    folder), all on the same seed and so the same world, stepped together; optionally an annotated video with one
+    panel per tracker side by side (each with its own banner, frames enlarged `scale` times), a progress bar (shown
+    once the episode has run for a second) and, for a single tracker, a MOTChallenge results file of its tracks
+    (`tracker.results`: the offline output of an offline method). Returns a record per tracker; its metrics are None
+    on a recorded sequence without ground truth."""
+    if results and len(specs) != 1:
+        raise ValueError("a results file takes one tracker")
+    runs = [_Episode(scenario, spec, seed, config, bool(video), scale) for spec in specs]
+    writer = VideoWriter(video, runs[0].env.metadata["render_fps"]) if video else None
+    limit = steps or runs[0].env.scenario.env.max_steps
+    steps_ = tqdm(range(limit), desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False) \
+        if progress else range(limit)
+    for _ in steps_:
+        panels = [run.step(bool(writer)) for run in runs]
+        if writer:  # panels side by side, a dark gap between them
+            gap = np.full((panels[0].shape[0], 4, 3), 30, np.uint8)
+            writer.write(np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1))
+        if runs[0].done:
+            break
+    if writer:
+        writer.close()
+    if results:
+        write_results(results, [(t.ids, t.boxes) for t in runs[0].agent.results(runs[0].online)])
+    return [run.record(scenario, seed, config) for run in runs]
 
 
 def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Mapping | None = None,
                 results: str | None = None, video: str | None = None, steps: int | None = None,
                 progress: bool = False) -> dict:
-    """One episode of `tracker` on `scenario` (a shipped key, a .toml file or a recorded sequence's folder); optionally
-    a MOTChallenge results file of its tracks (`tracker.results`: the offline output of an offline method), an
-    annotated video and a progress bar (shown once the episode has run for a second). Returns a record; its
-    metrics are None on a recorded sequence without ground truth."""
-    agent = trackers.make(tracker)
-    env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if video else None,
-                      obs_mode="frame+detections" if agent.needs_frame else "detections")
-    obs, info = env.reset(seed=seed)
-    agent.reset(info)
-    writer = VideoWriter(video, (env.scenario.render.width, env.scenario.render.height)) if video else None
-    tracker_time = env_time = 0.0
-    online: list[trackers.Tracks] = []
-    limit = steps or env.scenario.env.max_steps
-    steps_ = tqdm(range(limit), desc=f"{tracker} on {scenario}", unit="frame", delay=1.0, leave=False) if progress \
-        else range(limit)
-    for _ in steps_:
-        start = time.perf_counter()
-        tracks = agent.update(obs)
-        mid = time.perf_counter()
-        action = tracks.to_action(env.action_space)
-        n = action["num_tracks"]
-        online.append(trackers.Tracks.of(action["ids"][:n], action["boxes"][:n]))
-        if writer:
-            env.remember_tracks(tracks.ids, tracks.boxes)
-            writer.write(draw_debug(env.render(), agent.debug()))
-        obs, _, terminated, truncated, info = env.step(action)
-        tracker_time, env_time = tracker_time + mid - start, env_time + time.perf_counter() - mid
-        if terminated or truncated:
-            break
-    if writer:
-        writer.close()
-    if results:
-        write_results(results, [(t.ids, t.boxes) for t in agent.results(online)])
-    scored = env.recording is None or env.recording.scored
-    frames = len(online)
-    return {"tracker": tracker, "params": agent.params, "scenario": str(scenario), "seed": seed,
-            "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
-            "per_target": env.metrics.per_target() if scored else {},
-            "tracker_fps": frames / max(tracker_time, 1e-9), "env_fps": frames / max(env_time, 1e-9)}
+    """One episode of `tracker` on `scenario`: `run_episodes` with one tracker."""
+    return run_episodes(scenario, [tracker], seed, config, video, steps, progress, results=results)[0]
 
 
 def failed_record(task: tuple, message: str) -> dict:

@@ -301,6 +301,10 @@ class EpisodeMetrics:
         self.similarity_total += s
         return FrameStats(tp, fp, fn, idsw, len(g), s)
 
+    def __len__(self) -> int:
+        """Frames scored so far."""
+        return len(self._episode)
+
     def stored_bytes(self) -> int:
         """Bytes this episode's frames are kept in (for the global passes of `summary`)."""
         return self._episode.nbytes()

@@ -33,6 +33,22 @@ def test_run_prints_a_summary_and_writes_a_video(tmp_path, capsys):
     assert "MOTA" in text and "HOTA" in text and "tracker_fps" in text
     cap = cv2.VideoCapture(str(video))
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 30 and int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)) == 384
+    fourcc = int(cap.get(cv2.CAP_PROP_FOURCC)).to_bytes(4, "little").decode()
+    assert fourcc in ("avc1", "h264", "H264")  # H.264: browsers, Jupyter and GitHub play it
+
+
+def test_compare_writes_one_panel_per_tracker_side_by_side_as_a_gif(tmp_path, capsys):
+    import imageio_ffmpeg
+
+    gif = tmp_path / "side.gif"
+    assert cli.main(["run", "crossing", "--compare", "sort,jpda", "--steps", "6", "--scale", "2",
+                     "--video", str(gif)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("MOTA") == 2 and "jpda" in out
+    frames = imageio_ffmpeg.read_frames(str(gif))
+    meta = next(frames)
+    assert gif.read_bytes()[:4] == b"GIF8" and tuple(meta["size"]) == (2 * 2 * 384 + 4, 2 * 288)
+    assert sum(1 for _ in frames) == 3  # a GIF keeps every other frame
 
 
 def test_run_json_is_deterministic(capsys):
@@ -88,7 +104,10 @@ BAD_ARGUMENTS = [
     (["run", "crossing", "--tracker", "sortt"], r"unknown tracker 'sortt' \(did you mean 'sort'\?\)"),
     (["run", "crossing", "--tracker", "sort:max_age=-5"], r"parameter max_age='-5': allowed: an integer in \[0, inf\)"),
     (["run", "crossing", "--config", "sensor.pd=2"], r"argument --config: .*sensor\.pd = 2: out of range"),
-    (["run", "crossing", "--video", "out.gif"], r"argument --video: 'out.gif': the file name must end in \.mp4 or \.avi"),
+    (["run", "crossing", "--video", "out.avi"], r"argument --video: 'out.avi': the file name must end in \.mp4 or \.gif"),
+    (["run", "crossing", "--compare", "sort,iou", "--results", "r.txt"], r"argument --results: a results file takes one tracker"),
+    (["run", "crossing", "--scale", "9"], r"argument --scale: must be an integer in 1..8"),
+    (["run", "crossing", "--compare", "sort,nope"], r"argument --compare: .*nope"),
     (["run", "crossing", "--video", "/nowhere/out.mp4"], r"argument --video: .* folder '/nowhere' does not exist"),
     (["bench", "--scenarios", "crossing,nope", "--trackers", "sort"], r"argument --scenarios: unknown scenario 'nope'"),
     (["bench", "--scenarios", "crossing", "--trackers", "sort", "--metric", "MOTA,hotaa"],

@@ -47,6 +47,27 @@ def test_the_readme_example_runs():
     assert img.shape == (288, 384, 3) and not np.array_equal(img, obs["frame"])
 
 
+def test_render_draws_the_tracks_and_drawings_handed_over_on_the_frame_they_answer():
+    """The agent hands its tracks, its tracker's debug() drawings and its name to the env before stepping; render()
+    after the step shows them on the frame they answered, in the track's colour, enlarged render_scale times."""
+    from mtt_sim.overlay import track_color
+
+    env = gym.make("mtt_sim/Crossing-v0", render_mode="rgb_array", render_scale=2)
+    obs, _ = env.reset(seed=0)
+    bare = env.render()
+    assert bare.shape == (576, 768, 3)
+    ellipse = {"kind": "ellipse", "center": (100.0, 150.0), "axes": (30.0, 20.0), "angle": 0.0, "id": 7}
+    env.unwrapped.remember_tracks([7], [[90.0, 130.0, 20.0, 40.0]], [ellipse], "mine")
+    env.step(echo(obs))
+    img = env.render()
+    colour = np.array(track_color(7))
+    assert (np.abs(img[300, 254:262].astype(int) - colour).sum(axis=1) < 60).any()  # the ellipse's right edge (antialiased)
+    assert (np.abs(img[260:340, 180].astype(int) - colour).sum(axis=1) < 30).any()  # the box's left side
+    assert img.shape == bare.shape and not np.array_equal(img[30:], bare[30:])
+    with pytest.raises(ValueError, match="render_scale=0: allowed: an integer from 1 to 8"):
+        TrackingEnv("crossing", render_scale=0)
+
+
 def rollout(env_id, seed, steps=100, **kwargs):
     env = gym.make(env_id, **kwargs)
     obs, _ = env.reset(seed=seed)

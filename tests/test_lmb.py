@@ -164,7 +164,7 @@ def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_siz
     b, _ = run_tracker("lmb", "mtt_sim/Crossing-v0", {"env.max_steps": 60}, obs_mode="frame+detections")
     assert a == b and a["MOTA"] > 0.5
     drawn = tracker.debug()
-    assert {d["kind"] for d in drawn} == {"ellipse", "text"}
+    assert {d["kind"] for d in drawn} == {"ellipse", "bar"} and all(0 <= d["value"] <= 1 for d in drawn if d["kind"] == "bar")
     with pytest.raises(ValueError, match="image size"):
         trackers.make("lmb").reset({})
     with pytest.raises(ValueError, match="birth='sometimes': allowed: 'adaptive', 'fixed'"):

@@ -49,12 +49,13 @@ class Tracks:
         return {"ids": padded_ids, "boxes": padded_boxes, "num_tracks": len(ids)}
 
 
-def covariance_ellipse(centre, cov: np.ndarray, scale2: float, color) -> dict:
-    """A debug ellipse primitive: the set d^2 = scale2 of the 2-D Gaussian with covariance `cov` around `centre`."""
+def covariance_ellipse(centre, cov: np.ndarray, scale2: float, **style) -> dict:
+    """A debug ellipse primitive: the set d^2 = scale2 of the 2-D Gaussian with covariance `cov` around `centre`;
+    `style` is id=track id (drawn in its colour) or color=RGB."""
     eigval, eigvec = np.linalg.eigh(cov)
     angle = float(np.degrees(np.arctan2(eigvec[1, 1], eigvec[0, 1])))
     return {"kind": "ellipse", "center": centre, "axes": np.sqrt(scale2 * np.maximum(eigval[::-1], 0)), "angle": angle,
-            "color": color}
+            **style}
 
 
 def detections(obs: Mapping) -> np.ndarray:
@@ -196,8 +197,9 @@ class Tracker:
 
     def debug(self) -> list[dict]:
         """Drawable internals of the last update for overlays, as plain dicts with a "kind": "ellipse" (center,
-        axes, angle in degrees), "points" (xy (n, 2)), "box" (box x, y, w, h) or "text" (xy, text), and an
-        optional RGB "color". May be empty."""
+        axes, angle in degrees), "points" (xy (n, 2), optional "weights" and boolean "hidden"), "box" (box x, y, w,
+        h), "text" (xy, text: a short tag), "bar" (box of the track, "value" in [0, 1]) or "data" (not drawn), and
+        the track's "id" (drawn in its colour) or an RGB "color". May be empty."""
         return []
 
 

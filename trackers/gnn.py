@@ -29,11 +29,11 @@ class Gnn(Tracker):
         p = self.params
         self.book = TrackBook(KalmanBank(point_model(p["accel_sigma"], p["meas_sigma"])))
         self.gate = chi2_gate(2, p["gate_probability"])
-        self._gates = (np.zeros((0, 2)), np.zeros((0, 2, 2)))
+        self._gates = (np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2, 2)))
 
     def debug(self) -> list[dict]:
         """The validation gates of the last association: ellipses d^2 = gate around each predicted centre."""
-        return [covariance_ellipse(centre, S, self.gate, (0, 200, 255)) for centre, S in zip(*self._gates)]
+        return [covariance_ellipse(centre, S, self.gate, id=int(i)) for i, centre, S in zip(*self._gates)]
 
     def update(self, obs) -> Tracks:
         p, book = self.params, self.book
@@ -42,7 +42,7 @@ class Gnn(Tracker):
         centres = dets[:, :2] + dets[:, 2:4] / 2
         book.predict()
         cost = book.kf.mahalanobis(centres) if len(book) else np.zeros((0, len(dets)))
-        self._gates = (book.kf.measurement(), book.kf.innovation_covariance())
+        self._gates = (book.ids.copy(), book.kf.measurement(), book.kf.innovation_covariance())
         matches, _, new = assign(cost, self.gate)
         rows, cols = matches[:, 0], matches[:, 1]
         book.hit(rows, dets[cols, :4], dets[cols, 4], centres[cols])

@@ -55,7 +55,7 @@ class InteractiveParticleFilter(Tracker):
         self.sigma = np.sqrt(np.prod(self.sizes, axis=1)) / 2
         self.rng = np.random.default_rng(self.params["seed"])
         self.templates = None
-        self._cloud = (np.zeros((0, 0, 2)), np.zeros((0, 0)))
+        self._cloud = (np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0), bool))
 
     def _histograms(self, frame: np.ndarray, centres: np.ndarray, size) -> np.ndarray:
         p = self.params
@@ -98,14 +98,16 @@ class InteractiveParticleFilter(Tracker):
         weights = np.where(total > 0, weights / np.where(total > 0, total, 1.0), 1.0 / n)
         own_d2 = d2[np.arange(k), :, np.arange(k)] if k else np.zeros((0, n))
         self.estimates = self._settle(np.einsum("kn,knd->kd", weights, particles), own_d2.min(axis=1, initial=1.0))
-        self._cloud = (particles, weights)
+        self._cloud = (particles, weights, hidden if p["interactive"] and k > 1 else np.zeros((k, n), bool))
         boxes = np.c_[self.estimates - self.sizes / 2, self.sizes]
         return Tracks.of(self.ids, boxes, weights.max(axis=1) if k else np.zeros(0))
 
     def debug(self) -> list[dict]:
-        """Each target's particles and their weights."""
-        xy, w = self._cloud
-        return [{"kind": "points", "xy": xy[t], "weights": w[t], "color": (255, 255, 0)} for t in range(len(xy))]
+        """Each target's particles, their weights and which of them the interaction reweighted (hidden: inside
+        another target's conflict set, where that target explains the image better)."""
+        xy, w, hidden = self._cloud
+        return [{"kind": "points", "xy": xy[t], "weights": w[t], "hidden": hidden[t], "id": int(self.ids[t])}
+                for t in range(len(xy))]
 
 
 @register

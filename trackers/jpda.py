@@ -16,7 +16,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .assignment import chi2_gate, murty
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections, register
 from .kalman import KalmanBank, point_model
 
 
@@ -100,6 +100,8 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
 
 NORMAL, NEW, VANISHED, OCCLUDED, SPLIT, REVIVED = "normal", "new", "vanished", "occluded", "split", "revived"
 SEPARATED = "separated"
+TAGS = {NORMAL: "norm", NEW: "new", VANISHED: "miss", OCCLUDED: "occl", SPLIT: "split", REVIVED: "back",
+        SEPARATED: "sep"}  # the situations as short tags on video
 
 
 def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -440,12 +442,9 @@ class Jpda(Tracker):
         situation as text, and the validation matrix and beta as data."""
         out = []
         last = self.last
-        for centre, S, situation in zip(last["centres"], last["S"], last["situations"]):
-            val, vec = np.linalg.eigh(S)
-            out.append({"kind": "ellipse", "center": centre, "axes": np.sqrt(self.gate * val[::-1]),
-                        "angle": float(np.degrees(np.arctan2(vec[1, 1], vec[0, 1]))), "color": (0, 200, 255)})
-            out.append({"kind": "text", "xy": centre + np.array([6.0, -6.0]), "text": situation,
-                        "color": (255, 255, 255)})
+        for i, centre, S, situation in zip(last["ids"].tolist(), last["centres"], last["S"], last["situations"]):
+            out.append(covariance_ellipse(centre, S, self.gate, id=i))
+            out.append({"kind": "text", "xy": centre + np.array([6.0, -6.0]), "text": TAGS[situation], "id": i})
         out.append({"kind": "data", "ids": last["ids"], "validation": last["gated"], "beta": last["beta"]})
         return out
 

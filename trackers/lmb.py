@@ -276,13 +276,14 @@ class LabelledMultiBernoulli(Tracker):
         return beta
 
     def debug(self) -> list[dict]:
-        """Each track's existence probability (as text) and the covariance ellipse of its position (2 sigma)."""
+        """Each track's existence probability as a bar beside its box and the covariance ellipse of its position
+        (2 sigma): in the track's colour once it is reported (r above extract), grey before."""
         t = self.tracks
         out = []
         for k in t.best()[t.r > self.params["prune"] * 10]:
             i = t.track[k]
             x, y, w, h = t.m[k, :4]
-            colour = (0, 255, 0) if t.r[i] > self.params["extract"] else (160, 160, 160)
-            out.append(covariance_ellipse((x + w / 2, y + h / 2), t.P[k, :2, :2], 4.0, colour))
-            out.append({"kind": "text", "xy": (x, y - 3), "text": f"{t.label[i]}:{t.r[i]:.2f}", "color": colour})
+            style = {"id": int(t.label[i])} if t.r[i] > self.params["extract"] else {"color": (160, 160, 160)}
+            out.append(covariance_ellipse((x + w / 2, y + h / 2), t.P[k, :2, :2], 4.0, **style))
+            out.append({"kind": "bar", "box": (x, y, w, h), "value": float(t.r[i]), **style})
         return out

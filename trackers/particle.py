@@ -131,4 +131,4 @@ class ColourTextureParticleFilter(Tracker):
         if self.particles is None:
             return []
         xy, w = self._cloud
-        return [{"kind": "points", "xy": xy[t], "weights": w[t], "color": (255, 255, 0)} for t in range(len(xy))]
+        return [{"kind": "points", "xy": xy[t], "weights": w[t], "id": int(self.ids[t])} for t in range(len(xy))]
