@@ -26,7 +26,7 @@ Semantics, following TrackEval where other tools differ:
   assignment: (sum over assigned pairs of min(d, c)^p + c^p / 2 * (missed + false))^(1/p); the mean
   over frames is reported.
 - CentreError and CentreErrorVar: mean and variance of the distance between the box centres of the CLEAR
-  matches, pooled over targets (the error measure of seed 000's Tables 3 and 4), in pixels.
+  matches, pooled over targets (the error measure of the JPDA paper's Tables 3 and 4), in pixels.
 - Similarity "iou" is the box IoU; "centroid" is TrackEval's point similarity
   max(0, 1 - d / zero_distance) on box centres.
 """

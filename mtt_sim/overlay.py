@@ -173,7 +173,8 @@ class VideoWriter:
         if not Path(path).resolve().parent.is_dir():
             raise OSError(f"cannot write video file {path}: its folder does not exist")
         if suffix == ".mp4":
-            self._kind = {"codec": "libx264", "pix_fmt_out": "yuv420p", "output_params": ["-crf", "23"]}
+            self._kind = {"codec": "libx264", "pix_fmt_out": "yuv420p",
+                          "output_params": ["-crf", "23", "-preset", "veryfast"]}
         else:  # every other frame, one 64-colour palette, only each frame's changed rectangle stored: a scene's
             # camera noise changes every pixel, and a GIF has no other way to stay small
             self._kind = {"codec": "gif", "pix_fmt_out": "pal8", "output_params": [

@@ -257,9 +257,9 @@ def measure_pf(repeats: int = 5, frames: int = 60) -> list[dict]:
     """The particle filters' frames per second (tracker time only): pf with one target and 60 particles on 768x576
     umbrella frames, ipf with 4 books x 100 particles on 640x480; each against one cv2.calcHist per particle of
     its histogram alone (RGB 16^3 for pf, H-S 16x16 for ipf)."""
-    return [_particle_filter_row("pf (seed 001), 1 x 60 particles, 768x576", "pf", "umbrellas", 1, 60, _rgb_calchist,
+    return [_particle_filter_row("pf (Li et al. 2007), 1 x 60 particles, 768x576", "pf", "umbrellas", 1, 60, _rgb_calchist,
                                  repeats, frames),
-            _particle_filter_row("ipf (seed 002), 4 x 100 particles, 640x480", "ipf", "books", 4, 100, _hs_calchist,
+            _particle_filter_row("ipf (Liu et al. 2011), 4 x 100 particles, 640x480", "ipf", "books", 4, 100, _hs_calchist,
                                  repeats, frames)]
 
 

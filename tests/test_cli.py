@@ -226,7 +226,7 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert "stored per frame" in perf.report_metrics_memory(row)
     rows = perf.measure_pf(repeats=1, frames=2)
     assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf"] and all(r["fps"] > 0 for r in rows)
-    assert "| ipf (seed 002), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
+    assert "| ipf (Liu et al. 2011), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
 
 
 def test_sweep_writes_a_plot(tmp_path, capsys):

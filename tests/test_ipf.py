@@ -1,4 +1,4 @@
-"""Seed 002's interactive particle filter: the conflict set by hand, and runs through gym.make."""
+"""The interactive particle filter (Liu et al. 2011): the conflict set by hand, and runs through gym.make."""
 
 import itertools
 from pathlib import Path

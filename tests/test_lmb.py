@@ -1,4 +1,4 @@
-"""Seed 004's labelled multi-Bernoulli filter and the GM-PHD comparator: formulas with known answers, a plain
+"""The LMB tracker (Jiang and Yang) and the GM-PHD comparator: formulas with known answers, a plain
 Kalman filter, brute-force enumeration of hypotheses, and runs through gym.make."""
 
 import itertools

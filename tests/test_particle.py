@@ -1,4 +1,4 @@
-"""Seed 001's colour + texture particle filter, end to end on the umbrellas scene."""
+"""The colour + texture particle filter (Li, Zhang and Li 2007), end to end on the umbrellas scene."""
 
 import gymnasium as gym
 import numpy as np

@@ -1,4 +1,4 @@
-"""Seed 004's re-identification: SILTP codes by hand, LOMO's shape and lighting invariance, XQDA on data with a
+"""The LMB tracker's re-identification: SILTP codes by hand, LOMO's shape and lighting invariance, XQDA on data with a
 known answer, the FIFO pool, and `mtt-sim learn-reid` reproducing the shipped metric's recipe."""
 
 import numpy as np

@@ -64,7 +64,7 @@ def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[i
 
 
 def bhattacharyya(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of seed 001),
+    """Bhattacharyya coefficient rho = sum sqrt(p q) of each row of p (n, B) with q (B,) (eq. 4 of Li et al. 2007),
     or with every row of q (k, B) at once, (n, k). For one q only its nonzero bins can contribute, so only they
     are read."""
     q = np.asarray(q)
@@ -86,7 +86,7 @@ def orientation_maps(frame: np.ndarray, n_orient: int = 8) -> tuple[np.ndarray, 
 
 def gradient_descriptors(orient: np.ndarray, magnitude: np.ndarray, centres: np.ndarray, size: tuple[int, int],
                          cells: int = 4, n_orient: int = 8) -> np.ndarray:
-    """Gradient-orientation vectors (n, cells * cells * n_orient) of the regions (seed 001, Fig. 1, after SIFT).
+    """Gradient-orientation vectors (n, cells * cells * n_orient) of the regions (Li et al. 2007, Fig. 1, after SIFT).
 
     Each pixel's magnitude, weighted by a Gaussian centred on the region (sigma = half its width), is added to its
     cell's orientation bin; vectors are L2-normalised so distances compare across regions and contrasts.

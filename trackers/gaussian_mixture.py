@@ -1,7 +1,7 @@
 """Gaussian components of boxes for the random-finite-set trackers (LMB, GM-PHD), many at once.
 
 A component's state is (x, y, w, h, vx, vy, vw, vh): the box's top-left corner and size with their rates (the
-state of seed 004), moved by a constant-velocity model; the measurement is the box (x, y, w, h). Process and
+state of the LMB tracker), moved by a constant-velocity model; the measurement is the box (x, y, w, h). Process and
 measurement noise scale with each component's box size, so one model serves 20-pixel and 200-pixel targets.
 """
 

@@ -1,5 +1,5 @@
 """The Gaussian-mixture PHD filter (Vo and Ma 2006) with measurement-driven birth and labelled components: the
-"GMPHD" comparator of seed 004."""
+"GMPHD" comparator of the LMB paper."""
 
 from __future__ import annotations
 

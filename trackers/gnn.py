@@ -16,7 +16,7 @@ class Gnn(Tracker):
     chi-square gate (gate_probability, 2 degrees of freedom) are assigned by minimum total squared Mahalanobis
     distance; the box size is the last associated detection's. A new track is tentative until min_hits hits
     and deleted at its first miss; a confirmed one is deleted after max_age misses. Reported: confirmed tracks,
-    while matched (and while coasting if coast=true). The hard single-hypothesis association that seed 000
+    while matched (and while coasting if coast=true). The hard single-hypothesis association that the JPDA paper
     contrasts with JPDA."""
 
     name = "gnn"

@@ -1,4 +1,4 @@
-"""The IOU tracker (Bochinski, Eiselein, Sikora 2017; "IOU17" in seed 004): greedy high-overlap linking."""
+"""The IOU tracker (Bochinski, Eiselein, Sikora 2017; "IOU17" in the LMB paper): greedy high-overlap linking."""
 
 from __future__ import annotations
 

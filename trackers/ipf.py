@@ -1,4 +1,4 @@
-"""Seed 002 (Liu et al. 2011): the interactive particle filter, tracking several targets through full occlusion."""
+"""Liu et al. (2011): the interactive particle filter, tracking several targets through full occlusion."""
 
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ class InteractiveParticleFilter(Tracker):
     the paper): 4 books x 100 particles x 80 x 110 pixels would otherwise be 3.5 million pixels a frame."""
 
     name = "ipf"
-    description = "Seed 002: interactive particle filter through full occlusion (Liu et al. 2011; hand-initialised)"
+    description = "Interactive particle filter through full occlusion (Liu et al. 2011; hand-initialised)"
     parameters = {"particles": Param(100, "[1, 100000]"), "conflict_ratio": Param(0.75, "(0, 1]"),
                   "sigma2": Param(0.045, "(0, inf)"), "h_levels": Param(16, "[2, 180]"), "s_levels": Param(16, "[2, 256]"),
                   "interactive": Param(True), "samples": Param(256, "[0, inf)"), "seed": Param(0, "[0, inf)")}
@@ -112,13 +112,13 @@ class InteractiveParticleFilter(Tracker):
 
 @register
 class PathConsistencyParticleFilter(InteractiveParticleFilter):
-    """The baseline seed 002 compares against: independent particle filters (200 particles each, the paper's count
+    """The baseline the interactive filter's paper compares against: independent particle filters (200 particles each, the paper's count
     for it) that assume a consistent path. Particles are drawn around the constant-velocity prediction, and while a
     target's best particle is farther than `occluded_distance` (squared Bhattacharyya distance) from its template
     the target is taken as occluded and coasts on its velocity instead of following its weights."""
 
     name = "pcpf"
-    description = "Seed 002's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
+    description = "The interactive filter's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
     parameters = {**InteractiveParticleFilter.parameters, "particles": Param(200, "[1, 100000]"),
                   "interactive": Param(False), "occluded_distance": Param(0.3, "[0, 1]"),
                   "velocity_gain": Param(0.3, "[0, 1]")}

@@ -1,4 +1,4 @@
-"""Seed 000 (Wan, Wang, Yuan 2011): JPDA with Murty's K best joint events, for video multi-target tracking.
+"""Wan, Wang and Yuan (2011): JPDA with Murty's K best joint events, for video multi-target tracking.
 
 The association core. A joint event assigns each target at most one measurement and each measurement
 at most one target (the rest are clutter); in the standard parametric form of the paper's eq. 8,
@@ -135,7 +135,7 @@ def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
 
 @register
 class Jpda(Tracker):
-    """Seed 000: each target's box centre is Kalman-filtered with a constant-velocity model; measurements (detection
+    """Wan, Wang and Yuan (2011): each target's box centre is Kalman-filtered with a constant-velocity model; measurements (detection
     centres) within the gate d^2 <= chi2(gate_probability, 2) form the validation matrix; targets sharing
     measurements are clustered; in each cluster the joint-event probabilities (P_D, clutter density) give beta from
     the K most probable events found by Murty (K = targets + measurements, as in the paper) and the JPDA update
@@ -173,7 +173,7 @@ class Jpda(Tracker):
     clutter_density is false detections per px^2 per frame, pd the detection probability."""
 
     name = "jpda"
-    description = "Seed 000: JPDA with Murty's K best joint events and video motion situations (Wan et al. 2011)"
+    description = "JPDA with Murty's K best joint events and video motion situations (Wan, Wang and Yuan 2011)"
     parameters = {
         "pd": Param(0.9, "(0, 1)", "detection probability P_D"),
         "clutter_density": Param(1e-5, "(0, inf)", "clutter density lambda: false detections per px^2 per frame"),

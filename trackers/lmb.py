@@ -1,4 +1,4 @@
-"""Seed 004 (Jiang, Yang): a labelled multi-Bernoulli filter with Gaussian-mixture densities, gating and grouping,
+"""Jiang and Yang: a labelled multi-Bernoulli filter with Gaussian-mixture densities, gating and grouping,
 Murty-ranked association hypotheses, and a birth model driven by the detections and their confidences."""
 
 from __future__ import annotations
@@ -98,7 +98,7 @@ class _Mixture:
 
 @register
 class LabelledMultiBernoulli(Tracker):
-    """Labelled multi-Bernoulli filter (Reuter, Vo, Vo, Dietmayer 2014) as seed 004 uses it. Each track is a
+    """Labelled multi-Bernoulli filter (Reuter, Vo, Vo, Dietmayer 2014) as Jiang and Yang use it. Each track is a
     Bernoulli with existence probability r and a Gaussian mixture over (x, y, w, h, vx, vy, vw, vh). Prediction
     scales r by the survival probability; tracks and detections are gated (chi-square, `gate`) and split into
     independent groups; each group is updated as a delta-GLMB whose `hypotheses` best association hypotheses come
@@ -118,7 +118,7 @@ class LabelledMultiBernoulli(Tracker):
     that `mtt-sim learn-reid` wrote."""
 
     name = "lmb"
-    description = "Seed 004: labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth"
+    description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id (Jiang and Yang)"
     parameters = {**gm.MODEL_PARAMETERS, "hypotheses": Param(15, "[1, inf)"),
                   "birth": Param("adaptive", ("adaptive", "fixed")), "birth_max": Param(0.6, "(0, 1)"),
                   "fixed_births": Param(16, "[1, inf)"), "fixed_birth_r": Param(0.03, "(0, 1)"),

@@ -1,4 +1,4 @@
-"""Seed 001 (Li, Zhang, Li 2007): a particle filter fusing a colour histogram with a gradient-orientation texture
+"""Li, Zhang and Li (2007): a particle filter fusing a colour histogram with a gradient-orientation texture
 descriptor, with a template update guarded against occlusion."""
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ class ColourTextureParticleFilter(Tracker):
     in [0, 4]), so the defaults are 20 and 10; pass lam=0.02,mu=0.01 for the paper's values."""
 
     name = "pf"
-    description = "Seed 001: colour + gradient-orientation particle filter with template update (hand-initialised)"
+    description = "Colour + gradient-orientation particle filter with template update (Li, Zhang and Li 2007; hand-initialised)"
     parameters = {"particles": Param(60, "[1, 100000]"), "alpha": Param(0.6, "[0, 1]"), "lam": Param(20.0, "(0, inf)"),
                   "mu": Param(10.0, "(0, inf)"), "beta": Param(0.9, "[0, 1]"), "update_threshold": Param(0.3, "[0, 1]"),
                   "pos_sigma": Param(3.0, "[0, inf)"), "vel_sigma": Param(1.0, "[0, inf)"), "levels": Param(16, "[2, 64]"),

@@ -1,4 +1,4 @@
-"""Re-identification for seed 004: LOMO features (Liao et al. 2015) and the XQDA metric learned on crops the
+"""Re-identification for the LMB tracker (Jiang and Yang): LOMO features (Liao et al. 2015) and the XQDA metric learned on crops the
 simulator renders, plus the FIFO feature pool that gives a newborn track the label of a target seen before.
 
 LOMO, scaled down to our small targets: each crop is resized to 48 x 24, lit evenly by a two-scale Retinex,

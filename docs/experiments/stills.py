@@ -1,4 +1,5 @@
-"""The README's stills: each seed paper's tracker on the scene it was built for, and the side-by-side GIF.
+"""The README's stills: each paper's tracker on the scene it was built for, ByteTrack on mot17_like, and the
+side-by-side GIF.
 
 Each still is what `env.render()` shows once the agent hands its tracker's drawings to the env (the hand-over any
 Gym agent can use, `RecordVideo` included). Run from the repository root:
@@ -20,6 +21,7 @@ STILLS = [  # (env id, tracker, seed, frame, render scale, file)
     ("mtt_sim/Umbrellas-v0", "pf", 0, 40, 1, "docs/still_pf_umbrellas.jpg"),
     ("mtt_sim/Books-v0", "ipf", 0, 45, 1, "docs/still_ipf_books.jpg"),
     ("mtt_sim/Mot17Like-v0", "lmb", 0, 60, 1, "docs/still_lmb_mot17_like.jpg"),
+    ("mtt_sim/Mot17Like-v0", "bytetrack", 0, 120, 1, "docs/demo.jpg"),
 ]
 
 
