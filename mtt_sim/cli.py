@@ -267,7 +267,16 @@ def cmd_bench(args) -> int:
     if args.by == "target" and set(args.metric) - {"CentreError", "Coverage"}:
         raise UsageError("--metric", "with --by target: CentreError or Coverage (per-target metrics)")
     title = ",".join(args.scenarios) if args.by == "target" else ""
-    return _grid(args, args.scenarios, overrides, None, lambda records, metric: _table(records, metric, args.by, title))
+    _plot_output(args)
+    if args.plot and args.by == "target":
+        raise UsageError("--plot", "plots columns of scenarios: leave out --by target")
+
+    def plot(records):
+        from . import plots
+
+        plots.bench_plot(records, args.metric, args.plot)
+    return _grid(args, args.scenarios, overrides, None, lambda records, metric: _table(records, metric, args.by, title),
+                 plot)
 
 
 def cmd_sweep(args) -> int:
@@ -278,9 +287,7 @@ def cmd_sweep(args) -> int:
     overrides = _overrides(args)
     _loaded([args.scenario], overrides)
     _loaded([args.scenario], overrides, "--param", [{key: v} for v in values])
-    if args.plot:
-        _require("matplotlib", "--plot", "plot")
-        _output(args.plot, args.force, "--plot", (".png", ".pdf", ".svg"))
+    _plot_output(args)
 
     def table(records, metric) -> str:
         from . import experiment
@@ -288,12 +295,20 @@ def cmd_sweep(args) -> int:
         rows = experiment.summarize(records, metric, by="config")
         for r in rows:
             r["column"] = f"{key.split('.')[-1]}={json.loads(r['column'])[key]}"
-        if args.plot and metric == args.metric[-1] and rows:
-            experiment.sweep_plot(rows, key, values, args.plot)
-            print(f"plot: {args.plot} ({metric})")
         return experiment.markdown(rows, f"{args.scenario}, sweeping {key}") if rows else ""
 
-    return _grid(args, [args.scenario], overrides, [{key: v} for v in values], table)
+    def plot(records):
+        from . import plots
+
+        plots.sweep_plot(records, args.scenario, key, values, args.metric, args.plot)
+    return _grid(args, [args.scenario], overrides, [{key: v} for v in values], table, plot)
+
+
+def _plot_output(args) -> None:
+    """--plot's checks, before any work: matplotlib at hand, a file that can be written."""
+    if args.plot:
+        _require("matplotlib", "--plot", "plot")
+        _output(args.plot, args.force, "--plot", (".png", ".pdf", ".svg"))
 
 
 def _table(records, metric, by, title) -> str:
@@ -303,10 +318,10 @@ def _table(records, metric, by, title) -> str:
     return experiment.markdown(rows, title) if rows else ""
 
 
-def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
-    """Run a bench or sweep grid: records written as they finish, a table(records, metric) per metric and the failed
-    episodes at the end, and on Ctrl-C or SIGTERM the workers stopped and what finished kept. Exit status: 0, 1 if an
-    episode failed, 130 if interrupted."""
+def _grid(args, scenarios: list[str], overrides: dict, configs, table, plot) -> int:
+    """Run a bench or sweep grid: records written as they finish, a table(records, metric) per metric, with --plot
+    plot(records) (one panel per metric), and the failed episodes at the end, and on Ctrl-C or SIGTERM the workers
+    stopped and what finished kept. Exit status: 0, 1 if an episode failed, 130 if interrupted."""
     out = _output(args.out, args.force, "--out", (".csv", ".json"))
     if args.results_dir:
         folder = Path(args.results_dir)
@@ -339,6 +354,10 @@ def _grid(args, scenarios: list[str], overrides: dict, configs, table) -> int:
         experiment.write_records(records, out)  # again, in grid order
     done = [r for r in records if r is not None]
     print("\n\n".join(filter(None, (table(done, m) for m in args.metric))))
+    scored = [r for r in done if r["metrics"] is not None]
+    if args.plot and scored:
+        plot(scored)
+        print(f"\nplot: {args.plot} ({', '.join(args.metric)})" + (" (replaced)" if args.force else ""))
     failed = [r for r in done if r["error"]]
     if failed:
         print(f"\n{len(failed)} of {len(done)} episodes failed:")
@@ -549,8 +568,8 @@ def build_parser() -> argparse.ArgumentParser:
         else:
             g.add_argument("scenario", type=_scenario, help=scenario_help)
             g.add_argument("--param", required=True, metavar="KEY=V1,V2,...", help="e.g. sensor.clutter_rate=0,2,5,10,20")
-            g.add_argument("--plot", help="write the curve of the last --metric as a PNG, PDF or SVG (needs the [plot] "
-                                          "extra: matplotlib)")
+        g.add_argument("--plot", help="write a plot, one panel per --metric (bench: bars per scenario; sweep: curves), "
+                                      "as a PNG, PDF or SVG (needs the [plot] extra: matplotlib)")
         g.add_argument("--trackers", type=_tracker_specs, required=True,
                        help="tracker specs separated by commas, or by ';' when a spec has several parameters: "
                             "sort,iou,gnn:coast=true or 'sort:min_hits=1,max_age=5;iou'")

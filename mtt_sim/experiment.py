@@ -331,25 +331,3 @@ class RecordFile:
 
     def __exit__(self, *exc):
         self.close()
-
-
-def sweep_plot(rows: Sequence[dict], param: str, values: Sequence, path: str | Path) -> None:
-    """A stress curve (metric against the swept value, one line per tracker) as a PNG; needs matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise ImportError("the sweep plot needs matplotlib: pip install 'mtt-sim[plot]'") from None
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for t in dict.fromkeys(r["tracker"] for r in rows):
-        mine = [r for r in rows if r["tracker"] == t]
-        mean, ci = np.array([r["mean"] for r in mine]), np.array([r["ci95"] for r in mine])
-        ax.errorbar(values, mean, yerr=ci, marker="o", capsize=3, label=t)
-    ax.set_xlabel(param)
-    ax.set_ylabel(rows[0]["metric"])
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)

@@ -229,11 +229,25 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert "| ipf (Liu et al. 2011), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
 
 
-def test_sweep_writes_a_plot(tmp_path, capsys):
-    plot = tmp_path / "curve.png"
+def test_sweep_and_bench_plot_one_panel_per_metric(tmp_path, capsys):
+    curve, bars = tmp_path / "curve.png", tmp_path / "bars.png"
     assert cli.main(["sweep", "clutter_storm", "--param", "sensor.clutter_rate=0,20", "--trackers", "sort,iou",
-                     "--seeds", "2", "--config", "env.max_steps=10", "--plot", str(plot)]) == 0
-    assert plot.stat().st_size > 1000 and cv2.imread(str(plot)).shape[2] == 3
+                     "--seeds", "2", "--config", "env.max_steps=10", "--metric", "MOTA,IDF1", "--plot", str(curve)]) == 0
+    assert cli.main(["bench", "--scenarios", "clutter_storm,books", "--trackers", "sort,iou", "--seeds", "2",
+                     "--config", "env.max_steps=10", "--metric", "MOTA,IDF1,FP", "--plot", str(bars)]) == 0
+    assert "plot: " in capsys.readouterr().out
+    assert cv2.imread(str(curve)).shape == (456, 1080, 3) and cv2.imread(str(bars)).shape == (456, 1620, 3)
+
+
+def test_plot_intervals_stop_at_what_the_metric_can_take():
+    import numpy as np
+
+    from mtt_sim.plots import clipped_errors
+
+    np.testing.assert_allclose(clipped_errors("IDF1", np.array([0.9, 0.05]), np.array([0.2, 0.2])),
+                               [[0.2, 0.05], [0.1, 0.2]])
+    np.testing.assert_allclose(clipped_errors("MOTA", np.array([-3.0]), np.array([5.0])), [[5.0], [4.0]])
+    np.testing.assert_allclose(clipped_errors("FP", np.array([2.0]), np.array([5.0])), [[2.0], [5.0]])
 
 
 def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
