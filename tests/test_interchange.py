@@ -1,5 +1,8 @@
 """MOTChallenge export and evaluation round trips, and third-party trackers in the Gym loop."""
 
+import dataclasses
+from types import SimpleNamespace
+
 import cv2
 import numpy as np
 import pytest
@@ -109,6 +112,42 @@ def test_external_adapter_runs_a_third_party_tracker_in_the_gym_loop():
         trackers.External(SortReferenceStyle(), box_format="tlbr")
     with pytest.raises(TypeError, match="has no update"):
         trackers.External(object()).reset({})
+
+
+@dataclasses.dataclass
+class StandInDetections:
+    """What a supervision tracker reads and writes of `sv.Detections`, for a test without supervision installed."""
+
+    xyxy: np.ndarray
+    confidence: np.ndarray
+    class_id: np.ndarray
+    tracker_id: np.ndarray | None = None
+
+
+class SupervisionStyle:
+    """A tracker with supervision's interface, running the SORT-reference-style one above underneath."""
+
+    def __init__(self):
+        self.inner = SortReferenceStyle()
+
+    def update_with_detections(self, dets: StandInDetections) -> StandInDetections:
+        rows = self.inner.update(np.c_[dets.xyxy, dets.confidence])
+        return StandInDetections(rows[:, :4], np.ones(len(rows)), np.zeros(len(rows), int), rows[:, 4].astype(int))
+
+
+def test_a_supervision_tracker_runs_in_the_gym_loop():
+    _, _, ours = in_process("sort")
+    _, _, theirs = in_process(trackers.SupervisionTracker(factory=SupervisionStyle,
+                                                          detections_type=StandInDetections))
+    for key, value in ours.items():
+        assert theirs[key] == (value if isinstance(value, int) else pytest.approx(value, rel=1e-6)), key
+    with pytest.raises(TypeError, match="has no update_with_detections"):
+        trackers.SupervisionTracker(object(), detections_type=StandInDetections).reset({})
+    lost = trackers.SupervisionTracker(SimpleNamespace(update_with_detections=lambda d: "nothing"),
+                                       detections_type=StandInDetections)
+    lost.reset({})
+    with pytest.raises(ValueError, match="must return Detections with xyxy and tracker_id, got str"):
+        lost.update({"detections": np.zeros((1, 5), np.float32), "num_detections": 0})
 
 
 class Returns:

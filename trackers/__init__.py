@@ -9,5 +9,6 @@
 from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, lmb, particle, sort  # noqa: F401  (each registers its tracker)
 from .base import Param, Tracker, Tracks, available, make, parse_spec, register, split_specs
 from .external import External
+from .roboflow import SupervisionTracker
 
-__all__ = ["External", "Param", "Tracker", "Tracks", "available", "make", "parse_spec", "register", "split_specs"]
+__all__ = ["External", "SupervisionTracker", "Param", "Tracker", "Tracks", "available", "make", "parse_spec", "register", "split_specs"]
