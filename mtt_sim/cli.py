@@ -450,6 +450,23 @@ def cmd_export(args) -> int:
     return 0
 
 
+def cmd_docs(args) -> int:
+    out = Path(args.out)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
+        raise UsageError("--out", f"{args.out!r} exists and is not empty; add --force to replace the site")
+    _writable_folder(out if out.is_dir() else out.parent, "--out", args.out)
+    _require("mkdocs", "docs", "docs")
+    _require("material", "docs", "docs")
+    import tempfile
+
+    from . import docsite
+
+    with tempfile.TemporaryDirectory() as work:
+        docsite.build(out, Path(work))
+    print(f"site: {out / 'index.html'}")
+    return 0
+
+
 def cmd_eval(args) -> int:
     for argument, path, kind in (("--gt", Path(args.gt) / "gt" / "gt.txt", "a sequence folder with gt/gt.txt"),
                                  ("--results", Path(args.results), "a results file")):
@@ -651,6 +668,12 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--out", help="also write the tables to this Markdown file (.md)")
     va.add_argument("--force", action="store_true", help=force_help)
     va.set_defaults(func=cmd_validate)
+
+    dc = sub.add_parser("docs", help="build the documentation site (MkDocs): the README, a page per scenario and "
+                                     "per tracker, the configuration reference (the [docs] extra)")
+    dc.add_argument("--out", required=True, help="the site's folder")
+    dc.add_argument("--force", action="store_true", help=force_help)
+    dc.set_defaults(func=cmd_docs)
 
     cf = sub.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
     cf.add_argument("scenario", nargs="?", type=_scenario, help=scenario_help)

@@ -12,7 +12,7 @@ import cv2
 import pytest
 
 import trackers
-from mtt_sim import cli, experiment, perf
+from mtt_sim import cli, experiment, perf, scenario
 
 
 def mtt_sim(*args):
@@ -259,3 +259,16 @@ def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
     assert cli.main(["perf", "--repeats", "1"]) == 0
     captured = capsys.readouterr()
     assert captured.out.count("table of measure") == 6 and "measuring" in captured.err
+
+
+def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
+    site = tmp_path / "site"
+    assert cli.main(["docs", "--out", str(site)]) == 0
+    assert "site: " in capsys.readouterr().out and (site / "index.html").exists()
+    for key in scenario.available():
+        page = (site / "scenarios" / key / "index.html").read_text()
+        assert key in page and (site / "scenarios" / f"{key}.jpg").stat().st_size > 5000
+    for name in trackers.available():
+        assert "Parameters" in (site / "trackers" / name / "index.html").read_text()
+    assert "sensor.clutter_rate" in (site / "config" / "index.html").read_text()
+    assert cli.main(["docs", "--out", str(site)]) == 2  # there already

@@ -1,0 +1,97 @@
+"""`mtt-sim docs`: the documentation site, built with MkDocs (Material theme) from what the code already says: the
+README as the front page, a page per scenario (a still of the tracker it suits, its description, its TOML file), a
+page per tracker (its docstring and its parameters with their ranges and meanings) and the configuration reference.
+Needs the [docs] extra."""
+
+from __future__ import annotations
+
+import inspect
+import shutil
+import subprocess
+import sys
+from importlib import resources
+from pathlib import Path
+
+import cv2
+import gymnasium as gym
+
+import trackers
+
+from . import env_ids, scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+# The trackers each scenario was made for (the papers' scenes) or suits best, the first drawn in its still.
+SUITS = {"crossing": ("jpda", "gnn"), "soccer": ("jpda", "gnn"), "umbrellas": ("pf",), "books": ("ipf", "pcpf"),
+         "skating": ("ipf", "pf"), "mot17_like": ("lmb", "bytetrack", "sort"), "mot17_moving": ("bytetrack", "sort"),
+         "clutter_storm": ("bytetrack", "lmb"), "dense": ("bytetrack", "sort")}
+
+
+def still(key: str, spec: str, path: Path, frame: int = 30) -> None:
+    """Frame `frame` of seed 0 of scenario `key`, with `spec`'s tracks and drawings, as a JPEG."""
+    tracker = trackers.make(spec)
+    env = gym.make(env_ids()[key], render_mode="rgb_array",
+                   obs_mode="frame+detections" if tracker.needs_frame else "detections")
+    obs, info = env.reset(seed=0)
+    tracker.reset(info)
+    for _ in range(frame + 1):
+        tracks = tracker.update(obs)
+        env.unwrapped.remember_tracks(tracks.ids, tracks.boxes, tracker.debug(), spec)
+        obs, *_ = env.step(tracks.to_action(env.action_space))
+    cv2.imwrite(str(path), cv2.cvtColor(env.render(), cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 85])
+    env.close()
+
+
+def scenario_page(key: str, folder: Path) -> str:
+    suits = SUITS.get(key, ("sort",))
+    still(key, suits[0], folder / f"{key}.jpg")
+    toml = resources.files("mtt_sim.scenarios").joinpath(f"{key}.toml").read_text()
+    return "\n".join([f"# {key}", "", f"`gym.make(\"{env_ids()[key]}\")`", "", scenario.available()[key], "",
+                      f"![{key} with {suits[0]}]({key}.jpg)", "",
+                      "Suits: " + ", ".join(f"[`{t}`](../trackers/{t}.md)" for t in suits) + ".", "",
+                      "Its configuration file (every other key takes its default, see [Configuration](../config.md)):",
+                      "", "```toml", toml.rstrip(), "```", ""])
+
+
+def tracker_page(name: str) -> str:
+    cls = trackers.base.REGISTRY[name]
+    rows = ["| parameter | default | allowed | meaning |", "|---|---|---|---|"]
+    rows += [f"| `{key}` | `{p.default!r}` | {p.allowed_text()} | {p.meaning} |" for key, p in cls.parameters.items()]
+    doc = "\n\n".join(" ".join(par.split()) for par in inspect.cleandoc(cls.__doc__ or "").split("\n\n"))
+    return "\n".join([f"# {name}", "", f"**{cls.description}**", "", doc, "", "## Parameters", "",
+                      f"`trackers.make(\"{name}:key=value,...\")`, or `--trackers '{name}:key=value'` on the "
+                      "command line.", "", *rows, ""])
+
+
+def write_sources(folder: Path) -> None:
+    """The site's Markdown, images and mkdocs.yml under `folder` (the MkDocs project)."""
+    docs = folder / "docs"
+    for sub in ("scenarios", "trackers"):
+        (docs / sub).mkdir(parents=True, exist_ok=True)
+    (docs / "index.md").write_text((ROOT / "README.md").read_text())
+    shutil.copytree(ROOT / "docs", docs / "docs", dirs_exist_ok=True)  # the README's images and notebooks
+    (docs / "config.md").write_text("# Configuration\n\n" + scenario.reference_table() + "\n")
+    keys = sorted(scenario.available())
+    for key in keys:
+        (docs / "scenarios" / f"{key}.md").write_text(scenario_page(key, docs / "scenarios"))
+    names = sorted(trackers.base.REGISTRY)
+    for name in names:
+        (docs / "trackers" / f"{name}.md").write_text(tracker_page(name))
+    nav = ["  - Home: index.md", "  - Scenarios:", *[f"    - {k}: scenarios/{k}.md" for k in keys], "  - Trackers:",
+           *[f"    - {n}: trackers/{n}.md" for n in names], "  - Configuration: config.md"]
+    (folder / "mkdocs.yml").write_text("\n".join(["site_name: mtt-sim", "theme:", "  name: material", "nav:", *nav,
+                                                  ""]))
+
+
+def build(out: Path, work: Path) -> None:
+    """Write the sources into `work` and build the site into `out`."""
+    try:
+        import material  # noqa: F401  (the theme)
+        import mkdocs  # noqa: F401
+    except ImportError:
+        raise ImportError("the docs site needs MkDocs: pip install 'mtt-sim[docs]'") from None
+    write_sources(work)
+    done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--quiet", "--config-file",
+                           str(work / "mkdocs.yml"), "--site-dir", str(Path(out).resolve())],
+                          capture_output=True, text=True)
+    if done.returncode:
+        raise RuntimeError(f"mkdocs build failed:\n{done.stderr[-2000:]}")
