@@ -30,7 +30,7 @@ from .world import World
 
 _SPACE_KEYS = ("render.width", "render.height", "sensor.model", "sensor.max_detections", "sensor.conf_offset",
                "sensor.conf_scale", "env.max_tracks", "env.obs_mode")
-_TRAIL = 12
+_TRAIL = 40  # frames of a track's centre drawn behind it: long enough to show where it came from
 
 NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4))}  # the action that reports nothing
 
