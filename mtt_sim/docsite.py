@@ -89,9 +89,11 @@ def build(out: Path, work: Path) -> None:
         import mkdocs  # noqa: F401
     except ImportError:
         raise ImportError("the docs site needs MkDocs: pip install 'mtt-sim[docs]'") from None
+    if not (ROOT / "README.md").is_file() or not (ROOT / "docs").is_dir():
+        raise FileNotFoundError(f"the docs site is built from a source checkout: no README.md and docs/ in {ROOT}")
     write_sources(work)
     done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--quiet", "--config-file",
                            str(work / "mkdocs.yml"), "--site-dir", str(Path(out).resolve())],
                           capture_output=True, text=True)
     if done.returncode:
-        raise RuntimeError(f"mkdocs build failed:\n{done.stderr[-2000:]}")
+        raise OSError(f"mkdocs build failed:\n{done.stderr[-2000:]}")  # the external tool failed, as a file would
