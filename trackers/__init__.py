@@ -11,4 +11,5 @@ from .base import Param, Tracker, Tracks, available, make, parse_spec, register,
 from .external import External
 from .roboflow import SupervisionTracker
 
-__all__ = ["External", "SupervisionTracker", "Param", "Tracker", "Tracks", "available", "make", "parse_spec", "register", "split_specs"]
+__all__ = ["External", "SupervisionTracker", "Param", "Tracker", "Tracks",
+           "available", "make", "parse_spec", "register", "split_specs"]

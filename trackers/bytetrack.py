@@ -27,8 +27,12 @@ class ByteTrack(Tracker):
 
     name = "bytetrack"
     description = "ByteTrack (Zhang et al. 2022): two-stage association with high- and low-confidence detections"
-    parameters = {"track_thresh": Param(0.5), "track_buffer": Param(30, "[0, inf)"), "match_thresh": Param(0.8, "[0, 1]"),
-                  "mot20": Param(False), "frame_rate": Param(30.0, "(0, inf)")}
+    parameters = {
+        "track_thresh": Param(0.5, None, "confidence splitting high from low detections"),
+        "track_buffer": Param(30, "[0, inf)", "frames a lost track is kept (at 30 frames/s)"),
+        "match_thresh": Param(0.8, "[0, 1]", "largest cost (1 - IoU x score) of a first-round match"),
+        "mot20": Param(False, None, "the reference's MOT20 switch: no score fusion in the first round"),
+        "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)")}
 
     def reset(self, info=None):
         self.mean, self.cov = np.zeros((0, 8)), np.zeros((0, 8, 8))

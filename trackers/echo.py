@@ -14,7 +14,8 @@ class Echo(Tracker):
 
     name = "echo"
     description = "Floor baseline: each frame's detections as tracks, numbered afresh every frame"
-    parameters = {"min_confidence": Param(0.0)}
+    parameters = {
+        "min_confidence": Param(0.0, None, "detections below this confidence are dropped")}
 
     def update(self, obs) -> Tracks:
         dets = detections(obs)

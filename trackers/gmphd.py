@@ -26,9 +26,13 @@ class GaussianMixturePhd(Tracker):
 
     name = "gmphd"
     description = "GM-PHD filter (Vo and Ma 2006), measurement-driven birth, labels tagged through updates"
-    parameters = {**gm.MODEL_PARAMETERS, "birth_weight": Param(0.3, "(0, inf)"), "prune": Param(1e-4, "[0, 1)"),
-                  "merge": Param(4.0, "[0, inf)"), "max_components": Param(200, "[1, inf)"),
-                  "extract": Param(0.5, "(0, inf)")}
+    parameters = {
+        **gm.MODEL_PARAMETERS,
+        "birth_weight": Param(0.3, "(0, inf)", "newborn weight per unexplained detection (times its confidence)"),
+        "prune": Param(1e-4, "[0, 1)", "components lighter than this are dropped"),
+        "merge": Param(4.0, "[0, inf)", "Mahalanobis distance within which components merge"),
+        "max_components": Param(200, "[1, inf)", "most components kept"),
+        "extract": Param(0.5, "(0, inf)", "least weight of a reported state")}
 
     def reset(self, info=None):
         size = (info or {}).get("image_size")

@@ -45,9 +45,16 @@ class InteractiveParticleFilter(Tracker):
 
     name = "ipf"
     description = "Interactive particle filter through full occlusion (Liu et al. 2011; hand-initialised)"
-    parameters = {"particles": Param(100, "[1, 100000]"), "conflict_ratio": Param(0.75, "(0, 1]"),
-                  "sigma2": Param(0.045, "(0, inf)"), "h_levels": Param(16, "[2, 180]"), "s_levels": Param(16, "[2, 256]"),
-                  "interactive": Param(True), "samples": Param(256, "[0, inf)"), "seed": Param(0, "[0, inf)")}
+    parameters = {
+        "particles": Param(100, "[1, 100000]", "particles per target"),
+        "conflict_ratio": Param(0.75, "(0, 1]", "overlap (of the smaller box) that puts two targets' particles in "
+                                                "conflict"),
+        "sigma2": Param(0.045, "(0, inf)", "variance of the colour likelihood (eq. 6)"),
+        "h_levels": Param(16, "[2, 180]", "hue histogram levels"),
+        "s_levels": Param(16, "[2, 256]", "saturation histogram levels"),
+        "interactive": Param(True, None, "reweight conflicting particles (false: independent filters)"),
+        "samples": Param(256, "[0, inf)", "pixels sampled per region for its histogram (0: all)"),
+        "seed": Param(0, "[0, inf)", "the particles' random seed")}
     needs_frame = True
 
     def reset(self, info=None):
@@ -119,9 +126,13 @@ class PathConsistencyParticleFilter(InteractiveParticleFilter):
 
     name = "pcpf"
     description = "The interactive filter's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
-    parameters = {**InteractiveParticleFilter.parameters, "particles": Param(200, "[1, 100000]"),
-                  "interactive": Param(False), "occluded_distance": Param(0.3, "[0, 1]"),
-                  "velocity_gain": Param(0.3, "[0, 1]")}
+    parameters = {
+        **InteractiveParticleFilter.parameters,
+        "particles": Param(200, "[1, 100000]", "particles per target (the paper's count for this baseline)"),
+        "interactive": Param(False, None, "off: independent filters, the baseline"),
+        "occluded_distance": Param(0.3, "[0, 1]", "a target whose best particle is farther than this is occluded and "
+                                                  "coasts"),
+        "velocity_gain": Param(0.3, "[0, 1]", "how fast the velocity follows the estimates")}
 
     def reset(self, info=None):
         super().reset(info)

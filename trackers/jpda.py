@@ -181,7 +181,8 @@ class Jpda(Tracker):
         "k": Param(0, "[0, inf)", "joint events per cluster; 0: the paper's K = targets + measurements"),
         "vanish_frames": Param(3, "[1, inf)", "frames in a row without a measurement that end a target"),
         "revive_frames": Param(5, "[0, inf)", "frames an ended target can still be revived"),
-        "accel_sigma": Param(0.5, "[0, inf)", "white acceleration, px/frame^2 (Stone Soup ConstantVelocity(q): sqrt(q))"),
+        "accel_sigma": Param(0.5, "[0, inf)",
+                             "white acceleration, px/frame^2 (Stone Soup ConstantVelocity(q): sqrt(q))"),
         "meas_sigma": Param(4.0, "(0, inf)", "detection centre noise, px"),
         "min_confidence": Param(0.0, None, "detections below this confidence are dropped"),
         "situations": Param(True, None, "the paper's motion situations (false: traditional JPDA)"),
@@ -191,9 +192,10 @@ class Jpda(Tracker):
         "merge_frames": Param(40, "[1, inf)", "frames in one blob after which the younger target is a duplicate"),
         "coast": Param(True, None, "report confirmed targets through their misses (paper: false)"),
         "early_duplicates": Param(True, None, "drop a newborn duplicate before reading the situations (paper: false)"),
-        "occlusion_covariance": Param("position", ("position", "full"),
-                                      "what an occluded target's covariance restarts: position, or velocity too"),
-        "blob_report": Param("size", ("all", "size"), "merged targets reported: as many as the blob holds (paper: all)"),
+        "occlusion_covariance": Param("position", ("position", "full"), "what an occluded target's covariance "
+                                                                        "restarts: position, or velocity too"),
+        "blob_report": Param("size", ("all", "size"),
+                             "merged targets reported: as many as the blob holds (paper: all)"),
         "merge_needs_overlap": Param(True, None, "a merge needs overlapping predicted boxes (paper: false)")}
 
     def reset(self, info=None):
@@ -457,9 +459,10 @@ class JpdaExact(Jpda):
 
     name = "jpda_exact"
     description = "Traditional JPDA: every joint event enumerated (clusters capped at max_exact_targets targets)"
-    parameters = {**Jpda.parameters,
-                  "max_exact_targets": Param(8, "[0, 20]", "largest cluster (targets) whose joint events are all enumerated"),
-                  "max_events": Param(5000, "[1, inf)", "joint events (Murty's best) for a larger cluster")}
+    parameters = {
+        **Jpda.parameters,
+        "max_exact_targets": Param(8, "[0, 20]", "largest cluster (targets) whose joint events are all enumerated"),
+        "max_events": Param(5000, "[1, inf)", "joint events (Murty's best) for a larger cluster")}
 
     def _k(self, n_targets: int, n_measurements: int) -> int | None:
         return None if n_targets <= self.params["max_exact_targets"] else self.params["max_events"]

@@ -119,14 +119,27 @@ class LabelledMultiBernoulli(Tracker):
 
     name = "lmb"
     description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id (Jiang and Yang)"
-    parameters = {**gm.MODEL_PARAMETERS, "hypotheses": Param(15, "[1, inf)"),
-                  "birth": Param("adaptive", ("adaptive", "fixed")), "birth_max": Param(0.6, "(0, 1)"),
-                  "fixed_births": Param(16, "[1, inf)"), "fixed_birth_r": Param(0.03, "(0, 1)"),
-                  "extract": Param(0.5, "(0, 1)"), "prune": Param(1e-3, "[0, 1)"), "max_components": Param(4, "[1, inf)"),
-                  "use_low_confidence": Param(True), "low_confidence": Param(0.5), "reid": Param(True),
-                  "reid_confidence": Param(0.7), "reid_threshold": Param(5.0, "(0, inf)"),
-                  "pool_per_target": Param(10, "[1, inf)"), "pool_every": Param(10, "[1, inf)"),
-                  "reid_metric": Param("")}
+    parameters = {
+        **gm.MODEL_PARAMETERS,
+        "hypotheses": Param(15, "[1, inf)", "best association hypotheses per group (Murty)"),
+        "birth": Param("adaptive", ("adaptive", "fixed"), "adaptive: births from unexplained detections by "
+                                                          "confidence (the paper); fixed: along the borders"),
+        "birth_max": Param(0.6, "(0, 1)", "largest newborn existence probability (a fully confident, unexplained "
+                                          "detection)"),
+        "fixed_births": Param(16, "[1, inf)", "newborn components a frame with birth=fixed"),
+        "fixed_birth_r": Param(0.03, "(0, 1)", "their existence probability"),
+        "extract": Param(0.5, "(0, 1)", "least existence probability of a reported track"),
+        "prune": Param(1e-3, "[0, 1)", "tracks less likely than this are dropped"),
+        "max_components": Param(4, "[1, inf)", "most mixture components per track"),
+        "use_low_confidence": Param(True, None, "keep detections under low_confidence (false: the paper's Ours_2 "
+                                                "drops them)"),
+        "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
+        "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
+        "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool"),
+        "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification"),
+        "pool_per_target": Param(10, "[1, inf)", "pooled features per target of the first frame"),
+        "pool_every": Param(10, "[1, inf)", "frames between pool updates"),
+        "reid_metric": Param("", None, "an XQDA metric file from mtt-sim learn-reid (empty: the shipped one)")}
 
     @property
     def needs_frame(self) -> bool:

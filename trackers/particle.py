@@ -61,10 +61,17 @@ class ColourTextureParticleFilter(Tracker):
 
     name = "pf"
     description = "Colour + gradient-orientation particle filter with template update (Li, Zhang and Li 2007; hand-initialised)"
-    parameters = {"particles": Param(60, "[1, 100000]"), "alpha": Param(0.6, "[0, 1]"), "lam": Param(20.0, "(0, inf)"),
-                  "mu": Param(10.0, "(0, inf)"), "beta": Param(0.9, "[0, 1]"), "update_threshold": Param(0.3, "[0, 1]"),
-                  "pos_sigma": Param(3.0, "[0, inf)"), "vel_sigma": Param(1.0, "[0, inf)"), "levels": Param(16, "[2, 64]"),
-                  "seed": Param(0, "[0, inf)")}
+    parameters = {
+        "particles": Param(60, "[1, 100000]", "particles per target"),
+        "alpha": Param(0.6, "[0, 1]", "weight of colour against texture in the fused likelihood"),
+        "lam": Param(20.0, "(0, inf)", "colour likelihood exp(-lam d^2) (the paper: 0.02)"),
+        "mu": Param(10.0, "(0, inf)", "texture likelihood exp(-mu e^2) (the paper: 0.01)"),
+        "beta": Param(0.9, "[0, 1]", "template memory in the update (eq. 9-10)"),
+        "update_threshold": Param(0.3, "[0, 1]", "least likelihood of the estimate for a template update"),
+        "pos_sigma": Param(3.0, "[0, inf)", "position noise per frame, px"),
+        "vel_sigma": Param(1.0, "[0, inf)", "velocity noise per frame, px/frame"),
+        "levels": Param(16, "[2, 64]", "histogram levels per colour channel"),
+        "seed": Param(0, "[0, inf)", "the particles' random seed")}
     needs_frame = True
 
     def reset(self, info=None):
