@@ -1,7 +1,7 @@
 """`mtt-sim docs`: the documentation site, built with MkDocs (Material theme) from what the code already says: the
-README as the front page, a page per scenario (a still of the tracker it suits, its description, its TOML file), a
-page per tracker (its docstring and its parameters with their ranges and meanings) and the configuration reference.
-Needs the [docs] extra."""
+README as the front page, a page per scenario (a still and a short GIF of the tracker it suits, its description,
+its TOML file), a page per tracker (its docstring and its parameters with their ranges and meanings) and the
+configuration reference. Needs the [docs] extra."""
 
 from __future__ import annotations
 
@@ -18,8 +18,10 @@ import gymnasium as gym
 import trackers
 
 from . import env_ids, scenario
+from .experiment import run_episodes
 
 ROOT = Path(__file__).resolve().parent.parent
+GIF_FRAMES = 40
 # The trackers each scenario was made for (the papers' scenes) or suits best, the first drawn in its still.
 SUITS = {"crossing": ("jpda", "gnn"), "soccer": ("jpda", "gnn"), "umbrellas": ("pf",), "books": ("ipf", "pcpf"),
          "skating": ("ipf", "pf"), "mot17_like": ("lmb", "bytetrack", "sort"), "mot17_moving": ("bytetrack", "sort"),
@@ -44,9 +46,12 @@ def still(key: str, spec: str, path: Path, frame: int = 30) -> None:
 def scenario_page(key: str, folder: Path) -> str:
     suits = SUITS.get(key, ("sort",))
     still(key, suits[0], folder / f"{key}.jpg")
+    run_episodes(key, [suits[0]], seed=0, video=str(folder / f"{key}.gif"), steps=GIF_FRAMES)
     toml = resources.files("mtt_sim.scenarios").joinpath(f"{key}.toml").read_text()
     return "\n".join([f"# {key}", "", f"`gym.make(\"{env_ids()[key]}\")`", "", scenario.available()[key], "",
                       f"![{key} with {suits[0]}]({key}.jpg)", "",
+                      f"The first {GIF_FRAMES} frames of seed 0 (every other one):", "",
+                      f"![{key}, the first frames]({key}.gif)", "",
                       "Suits: " + ", ".join(f"[`{t}`](../trackers/{t}.md)" for t in suits) + ".", "",
                       "Its configuration file (every other key takes its default, see [Configuration](../config.md)):",
                       "", "```toml", toml.rstrip(), "```", ""])

@@ -268,6 +268,7 @@ def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
     for key in scenario.available():
         page = (site / "scenarios" / key / "index.html").read_text()
         assert key in page and (site / "scenarios" / f"{key}.jpg").stat().st_size > 5000
+        assert (site / "scenarios" / f"{key}.gif").read_bytes()[:4] == b"GIF8"
     for name in trackers.available():
         assert "Parameters" in (site / "trackers" / name / "index.html").read_text()
     assert "sensor.clutter_rate" in (site / "config" / "index.html").read_text()
