@@ -562,8 +562,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--steps", type=_integer(1), default=None, help="at most this many steps (default: the "
                                                                         "scenario's env.max_steps)")
     run.add_argument("--video", help="write an annotated video: .mp4 (H.264) or .gif")
-    run.add_argument("--compare", type=_tracker_specs, help="several trackers on the same episode, one video panel each, side by side "
-                                       "(comma-separated specs, or ';'-separated: 'sort;jpda:coast=false')")
+    run.add_argument("--compare", type=_tracker_specs,
+                     help="several trackers on the same episode, one video panel each, side by side (comma-separated "
+                          "specs, or ';'-separated: 'sort;jpda:coast=false')")
     run.add_argument("--scale", type=_integer(1, 8), default=1, help="enlarge the video's frames this many "
                                                                      "times (1 to 8; for small scenes)")
     run.add_argument("--results", help="write the tracks as a MOTChallenge results file (.txt; an offline method's "

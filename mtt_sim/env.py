@@ -79,7 +79,8 @@ class TrackingEnv(gym.Env):
     def __init__(self, scenario: str | os.PathLike | scn.Scenario | None = "crossing", config: Mapping | None = None,
                  render_mode: str | None = None, obs_mode: str | None = None, sequence: str | os.PathLike | None = None,
                  benchmark: str | None = None, sensor: str | os.PathLike | None = None, render_scale: int = 1):
-        if not isinstance(render_scale, (int, np.integer)) or isinstance(render_scale, bool) or not 1 <= render_scale <= 8:
+        whole = isinstance(render_scale, (int, np.integer)) and not isinstance(render_scale, bool)
+        if not whole or not 1 <= render_scale <= 8:
             raise ValueError(f"render_scale={render_scale!r}: allowed: an integer from 1 to 8 (how many times render() "
                              "enlarges the frame)")
         self.render_scale = int(render_scale)

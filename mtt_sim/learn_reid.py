@@ -1,4 +1,5 @@
-"""`mtt-sim learn-reid`: learn the XQDA re-identification metric of the LMB tracker (Jiang and Yang) from crops the simulator renders.
+"""`mtt-sim learn-reid`: learn the XQDA re-identification metric of the LMB tracker (Jiang and Yang) from crops the
+simulator renders.
 
 The same target at two times is one class. Crops come from the ground-truth boxes of well-visible targets every
 few frames of training episodes (seeds far from the 0..9 of the experiments), so the metric learns what changes

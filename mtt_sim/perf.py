@@ -178,7 +178,8 @@ def report_jpda(rows: list[dict]) -> str:
     out = ["jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
            "| targets | jpda ms/frame | gnn ms/frame | jpda / gnn |", "|---:|---:|---:|---:|"]
     out += [f"| {r['targets']} | {r['jpda_ms']:.2f} | {r['gnn_ms']:.2f} | {r['jpda_over_gnn']:.2f}x |" for r in rows]
-    out += ["jpda's parameters (its defaults, as measured):"] + ["    " + line for line in trackers.base.describe("jpda")]
+    out += ["jpda's parameters (its defaults, as measured):"]
+    out += ["    " + line for line in trackers.base.describe("jpda")]
     return "\n".join(out)
 
 
@@ -257,10 +258,10 @@ def measure_pf(repeats: int = 5, frames: int = 60) -> list[dict]:
     """The particle filters' frames per second (tracker time only): pf with one target and 60 particles on 768x576
     umbrella frames, ipf with 4 books x 100 particles on 640x480; each against one cv2.calcHist per particle of
     its histogram alone (RGB 16^3 for pf, H-S 16x16 for ipf)."""
-    return [_particle_filter_row("pf (Li et al. 2007), 1 x 60 particles, 768x576", "pf", "umbrellas", 1, 60, _rgb_calchist,
-                                 repeats, frames),
-            _particle_filter_row("ipf (Liu et al. 2011), 4 x 100 particles, 640x480", "ipf", "books", 4, 100, _hs_calchist,
-                                 repeats, frames)]
+    return [_particle_filter_row("pf (Li et al. 2007), 1 x 60 particles, 768x576", "pf", "umbrellas", 1, 60,
+                                 _rgb_calchist, repeats, frames),
+            _particle_filter_row("ipf (Liu et al. 2011), 4 x 100 particles, 640x480", "ipf", "books", 4, 100,
+                                 _hs_calchist, repeats, frames)]
 
 
 def report_pf(rows: list[dict]) -> str:

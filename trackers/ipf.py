@@ -119,13 +119,14 @@ class InteractiveParticleFilter(Tracker):
 
 @register
 class PathConsistencyParticleFilter(InteractiveParticleFilter):
-    """The baseline the interactive filter's paper compares against: independent particle filters (200 particles each, the paper's count
-    for it) that assume a consistent path. Particles are drawn around the constant-velocity prediction, and while a
+    """The baseline the interactive filter's paper compares against: independent particle filters (200 particles
+    each, the paper's count for it) that assume a consistent path. Particles are drawn around the constant-velocity prediction, and while a
     target's best particle is farther than `occluded_distance` (squared Bhattacharyya distance) from its template
     the target is taken as occluded and coasts on its velocity instead of following its weights."""
 
     name = "pcpf"
-    description = "The interactive filter's baseline: path-consistency (constant-velocity) particle filters (hand-initialised)"
+    description = "The interactive filter's baseline: path-consistency (constant-velocity) particle filters " \
+                  "(hand-initialised)"
     parameters = {
         **InteractiveParticleFilter.parameters,
         "particles": Param(200, "[1, 100000]", "particles per target (the paper's count for this baseline)"),

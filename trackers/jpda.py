@@ -135,8 +135,8 @@ def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
 
 @register
 class Jpda(Tracker):
-    """Wan, Wang and Yuan (2011): each target's box centre is Kalman-filtered with a constant-velocity model; measurements (detection
-    centres) within the gate d^2 <= chi2(gate_probability, 2) form the validation matrix; targets sharing
+    """Wan, Wang and Yuan (2011): each target's box centre is Kalman-filtered with a constant-velocity model;
+    measurements (detection centres) within the gate d^2 <= chi2(gate_probability, 2) form the validation matrix; targets sharing
     measurements are clustered; in each cluster the joint-event probabilities (P_D, clutter density) give beta from
     the K most probable events found by Murty (K = targets + measurements, as in the paper) and the JPDA update
     combines all gated measurements. beta' then classifies each target (normal, new, vanished, occluded, split):

@@ -118,7 +118,8 @@ class LabelledMultiBernoulli(Tracker):
     that `mtt-sim learn-reid` wrote."""
 
     name = "lmb"
-    description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id (Jiang and Yang)"
+    description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id " \
+                  "(Jiang and Yang)"
     parameters = {
         **gm.MODEL_PARAMETERS,
         "hypotheses": Param(15, "[1, inf)", "best association hypotheses per group (Murty)"),

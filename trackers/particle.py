@@ -60,7 +60,8 @@ class ColourTextureParticleFilter(Tracker):
     in [0, 4]), so the defaults are 20 and 10; pass lam=0.02,mu=0.01 for the paper's values."""
 
     name = "pf"
-    description = "Colour + gradient-orientation particle filter with template update (Li, Zhang and Li 2007; hand-initialised)"
+    description = "Colour + gradient-orientation particle filter with template update (Li, Zhang and Li 2007; " \
+                  "hand-initialised)"
     parameters = {
         "particles": Param(60, "[1, 100000]", "particles per target"),
         "alpha": Param(0.6, "[0, 1]", "weight of colour against texture in the fused likelihood"),

@@ -1,5 +1,6 @@
-"""Re-identification for the LMB tracker (Jiang and Yang): LOMO features (Liao et al. 2015) and the XQDA metric learned on crops the
-simulator renders, plus the FIFO feature pool that gives a newborn track the label of a target seen before.
+"""Re-identification for the LMB tracker (Jiang and Yang): LOMO features (Liao et al. 2015) and the XQDA
+metric learned on crops the simulator renders, plus the FIFO feature pool that gives a newborn track the label of a
+target seen before.
 
 LOMO, scaled down to our small targets: each crop is resized to 48 x 24, lit evenly by a two-scale Retinex,
 and described on a 3-level pyramid by 8 x 8 windows (stride 4) holding an 8 x 8 x 8 HSV histogram and two
