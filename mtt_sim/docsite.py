@@ -28,12 +28,13 @@ SUITS = {"crossing": ("jpda", "gnn"), "soccer": ("jpda", "gnn"), "umbrellas": ("
          "clutter_storm": ("bytetrack", "lmb"), "dense": ("bytetrack", "sort")}
 
 
-def still(key: str, spec: str, path: Path, frame: int = 30) -> None:
-    """Frame `frame` of seed 0 of scenario `key`, with `spec`'s tracks and drawings, as a JPEG."""
+def still(key: str, spec: str, path: Path, frame: int = 30, seed: int = 0, scale: int = 1) -> None:
+    """Frame `frame` of scenario `key`'s episode `seed`, with `spec`'s tracks and the drawings it hands to the env,
+    enlarged `scale` times, as a JPEG."""
     tracker = trackers.make(spec)
-    env = gym.make(env_ids()[key], render_mode="rgb_array",
+    env = gym.make(env_ids()[key], render_mode="rgb_array", render_scale=scale,
                    obs_mode="frame+detections" if tracker.needs_frame else "detections")
-    obs, info = env.reset(seed=0)
+    obs, info = env.reset(seed=seed)
     tracker.reset(info)
     for _ in range(frame + 1):
         tracks = tracker.update(obs)

@@ -15,14 +15,14 @@ GT_COLOR = (40, 220, 40)
 DET_COLOR = (250, 220, 0)
 # Track hues leave out the band from orange-yellow to green (0.10 to 0.45 of the hue circle), where the truth's green
 # and the detections' yellow lie: a track is never mistaken for either.
-_FREE_HUES, _SKIPPED = (0.0, 0.10, 0.45), 0.35
+_SKIP = (0.10, 0.45)
 
 
 def track_color(track_id: int) -> tuple[int, ...]:
     """A stable colour per track id: golden-ratio steps around the hue circle, outside the truth's and the
     detections' hues."""
-    u = (0.618034 * track_id) % 1.0 * (1.0 - _SKIPPED)
-    hue = u if u < _FREE_HUES[1] else u + _SKIPPED
+    u = (0.618034 * track_id) % 1.0 * (1.0 - (_SKIP[1] - _SKIP[0]))
+    hue = u if u < _SKIP[0] else u + _SKIP[1] - _SKIP[0]
     return tuple(int(c) for c in hue_colors(np.array([hue]))[0])
 
 

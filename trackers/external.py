@@ -41,11 +41,15 @@ class External(Tracker):
         if self.box_format == "xyxy":
             dets[:, 2:4] += dets[:, :2]
         args = (dets, frame_of(obs)) if self.needs_frame else (dets,)
-        out = _track_rows(self.model.update(*args))
-        boxes = out[:, :4].copy()
-        if self.box_format == "xyxy":
-            boxes[:, 2:] -= boxes[:, :2]
-        return Tracks.of(out[:, 4].astype(np.int64), boxes, np.ones(len(out)))
+        return to_tracks(_track_rows(self.model.update(*args)), self.box_format)
+
+
+def to_tracks(rows: np.ndarray, box_format: str) -> Tracks:
+    """Checked (m, >= 5) rows of boxes (x, y, w, h or x1, y1, x2, y2) and ids as Tracks, each with score 1."""
+    boxes = rows[:, :4].copy()
+    if box_format == "xyxy":
+        boxes[:, 2:] -= boxes[:, :2]
+    return Tracks.of(rows[:, 4].astype(np.int64), boxes, np.ones(len(rows)))
 
 
 def _track_rows(out) -> np.ndarray:

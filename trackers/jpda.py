@@ -104,6 +104,11 @@ TAGS = {NORMAL: "norm", NEW: "new", VANISHED: "miss", OCCLUDED: "occl", SPLIT: "
         SEPARATED: "sep"}  # the situations as short tags on video
 
 
+def _most_probable(beta: np.ndarray) -> np.ndarray:
+    """Each target's most probable measurement (column of beta past the first; 0 when there is none)."""
+    return np.argmax(beta[:, 1:], axis=1) if beta.shape[1] > 1 else np.zeros(len(beta), int)
+
+
 def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Cluster labels of targets (rows) and measurements (columns) linked by gated pairs (connected components)."""
     n, m = gated.shape
@@ -226,17 +231,17 @@ class Jpda(Tracker):
         beta, gated, g = self._associate(z)
         situ, unexplained = situations(beta[:, 1:].T)
         if p["situations"] and p["early_duplicates"] and len(z) and \
-                self._drop_duplicates(situ, np.argmax(beta[:, 1:], axis=1), newborn_only=True):
+                self._drop_duplicates(situ, _most_probable(beta), newborn_only=True):
             beta, gated, g = self._associate(z)  # without the newborn duplicates: the elder is not snapped
             situ, unexplained = situations(beta[:, 1:].T)
         if p["situations"] and p["merge_needs_overlap"]:
-            self._apart_is_not_merged(situ, np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int))
+            self._apart_is_not_merged(situ, _most_probable(beta))
         if p["situations"]:
             self._separate(situ, beta, g)
         self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": self.ids.copy(),
                      "centres": self.kf.measurement(), "S": self.kf.innovation_covariance()}
         self._jpda_update(beta, z)
-        best = np.argmax(beta[:, 1:], axis=1) if len(z) else np.zeros(len(beta), int)
+        best = _most_probable(beta)
         kind = np.array(situ, dtype=object)
         occluded = np.flatnonzero(kind == OCCLUDED) if p["situations"] else np.zeros(0, int)
         # The merged blob's centre (section 5, 4). The paper also zeroes the velocity, so merged targets share one

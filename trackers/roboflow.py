@@ -10,7 +10,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .base import Tracker, Tracks, detections
-from .external import _track_rows
+from .external import _track_rows, to_tracks
 
 
 class SupervisionTracker(Tracker):
@@ -52,7 +52,5 @@ class SupervisionTracker(Tracker):
         if ids is None or getattr(out, "xyxy", None) is None:
             raise ValueError("supervision: update_with_detections() must return Detections with xyxy and tracker_id, "
                              f"got {type(out).__name__}")
-        rows = _track_rows(np.c_[np.asarray(out.xyxy, float).reshape(-1, 4), np.asarray(ids, float).reshape(-1)])
-        boxes = rows[:, :4].copy()
-        boxes[:, 2:] -= boxes[:, :2]
-        return Tracks.of(rows[:, 4].astype(np.int64), boxes, np.ones(len(rows)))
+        return to_tracks(_track_rows(np.c_[np.asarray(out.xyxy, float).reshape(-1, 4),
+                                           np.asarray(ids, float).reshape(-1)]), "xyxy")
