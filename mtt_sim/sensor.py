@@ -71,11 +71,12 @@ def true_confidence(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfi
 
 def _union(boxes: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
     """Union box of the boxes in each group."""
-    lo = np.full((n_groups, 2), np.inf)
-    hi = np.full((n_groups, 2), -np.inf)
-    np.minimum.at(lo, groups, boxes[:, :2])
-    np.maximum.at(hi, groups, boxes[:, :2] + boxes[:, 2:])
-    return np.concatenate([lo, hi - lo], axis=1)
+    lo = np.full((2, n_groups), np.inf)
+    hi = np.full((2, n_groups), -np.inf)
+    for axis in (0, 1):  # one-dimensional ufunc.at has a fast path (about 40x the two-dimensional one)
+        np.minimum.at(lo[axis], groups, boxes[:, axis])
+        np.maximum.at(hi[axis], groups, boxes[:, axis] + boxes[:, 2 + axis])
+    return np.concatenate([lo, hi - lo]).T
 
 
 def touching(labels: np.ndarray, la: int, lb: int, box: np.ndarray) -> bool:
@@ -418,17 +419,29 @@ class ForegroundSensor(Sensor):
         cfg = self.cfg
         gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         diff = cv2.absdiff(gray, cv2.convertScaleAbs(self.model))
-        mask = (diff > cfg.threshold).astype(np.uint8)
+        mask = cv2.threshold(diff, cfg.threshold, 1, cv2.THRESH_BINARY)[1]  # diff > threshold (diff is integer)
         mask = cv2.morphologyEx(cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.open), cv2.MORPH_CLOSE, self.close)
-        count, comp, stats, _ = cv2.connectedComponentsWithStatsWithAlgorithm(mask, 8, cv2.CV_32S, cv2.CCL_GRANA)
+        count, comp = cv2.connectedComponentsWithAlgorithm(mask, 8, cv2.CV_32S, cv2.CCL_GRANA)
         cv2.accumulateWeighted(gray, self.model, cfg.learning_rate, mask=1 - mask)
-        area = stats[1:, cv2.CC_STAT_AREA].astype(float)
+        area, boxes, summed = component_stats(comp, count, mask, diff)
         keep = np.flatnonzero(area >= max(cfg.min_area, 1))
-        contrast = np.bincount(comp.ravel(), weights=diff.ravel(), minlength=count)[1:][keep] / area[keep]
+        contrast = summed[keep] / area[keep]
         # confidence: strong contrast and a target-sized area make a blob believable
         mean = np.clip(contrast / (4 * cfg.threshold), 0, 1) * (1 - np.exp(-area[keep] / (5 * max(cfg.min_area, 1))))
-        boxes = stats[1:][keep, :4].astype(float)
-        return self._finish(boxes, mean, np.full(len(keep), UNKNOWN), truth)
+        return self._finish(boxes[keep], mean, np.full(len(keep), UNKNOWN), truth)
+
+
+def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.ndarray):
+    """Area, box x, y, w, h and summed `weights` of components 1..count-1 of label image `comp` (nonzero where `mask`
+    is), as floats. Read from the foreground pixels alone: cv2's own stats pass scans the whole image (on two
+    threads, for two thirds of a step's time on a mostly empty frame)."""
+    xy = cv2.findNonZero(mask)
+    xy = np.zeros((0, 2), np.int32) if xy is None else xy.reshape(-1, 2)
+    x, y = xy[:, 0], xy[:, 1]
+    which = comp[y, x] - 1
+    area = np.bincount(which, minlength=count - 1).astype(float)
+    boxes = _union(np.c_[xy, np.ones_like(xy)].astype(float), which, count - 1)
+    return area, boxes, np.bincount(which, weights=weights[y, x], minlength=count - 1)
 
 
 def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray) -> Sensor:
