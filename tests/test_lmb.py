@@ -5,6 +5,8 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import trackers
 from helpers import placed, run_tracker, still, tiny
@@ -157,6 +159,56 @@ def test_gmphd_cardinality_on_a_static_scene_converges_to_the_true_count():
         counts.append(phd.w.sum())
     assert counts[0] == 0 and reported[0] == 0               # births wait for the next frame
     assert np.allclose(counts[-10:], 3, atol=0.05) and reported[-10:] == [3] * 10
+
+
+def random_mixture(seed: int, n: int, axis_aligned: bool = False):
+    """n components clustered in a few places (so some merge), with random positive-definite covariances; axis
+    aligned: diagonal covariances and components that differ in x or in y alone, where the one-coordinate bound
+    `within_distance` prunes with is exact."""
+    rng = np.random.default_rng(seed)
+    m = rng.uniform(0, 200, (n // 4 + 1, gm.DIM))[np.arange(n) // 4] + rng.normal(0, 3, (n, gm.DIM))
+    a = rng.normal(0, 2, (n, gm.DIM, gm.DIM))
+    P = a @ a.transpose(0, 2, 1) + np.eye(gm.DIM)
+    if axis_aligned:
+        m[:, 2:] = 0
+        m[np.arange(n), rng.integers(0, 2, n)] = 0
+        P = P * np.eye(gm.DIM)
+    return rng.uniform(0.01, 1, n), m, P
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 40), st.floats(0.5, 20), st.booleans())
+def test_within_distance_finds_exactly_the_pairs_brute_force_finds(seed, n, limit, axis_aligned):
+    _, m, P = random_mixture(seed, n, axis_aligned)
+    d = m[None, :, :] - m[:, None, :]
+    brute = np.einsum("kni,kij,knj->kn", d, np.linalg.inv(P), d) <= limit
+    near = gm.within_distance(m, P, limit)
+    assert [sorted(c.tolist()) for c in near] == [np.flatnonzero(row).tolist() for row in brute]
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 40), st.integers(1, 12))
+def test_gmphd_merge_is_vo_and_mas_greedy_merge(seed, n, cap):
+    """Table II of Vo and Ma (2006), written out: the heaviest open component absorbs every open one within the
+    merge distance, until max_components are made."""
+    w, m, P = random_mixture(seed, n)
+    phd = trackers.make("gmphd", merge=4.0, max_components=cap)
+    phd._prune_and_merge(w, m, P, np.arange(n))
+    open_, expected = np.ones(n, bool), []
+    for k in np.argsort(-w, kind="stable"):
+        if open_[k] and len(expected) < cap:
+            d = m - m[k]
+            near = open_ & (np.einsum("ni,ij,nj->n", d, np.linalg.inv(P[k]), d) <= 4.0)
+            wn, total = w[near], w[near].sum()
+            mean = wn @ m[near] / total
+            s = m[near] - mean
+            cov = (np.einsum("n,nij->ij", wn, P[near]) + np.einsum("n,ni,nj->ij", wn, s, s)) / total
+            expected.append((total, k, mean, cov))
+            open_ &= ~near
+    expected.sort(key=lambda e: -e[0])
+    assert phd.label.tolist() == [e[1] for e in expected]
+    assert np.allclose(phd.w, [e[0] for e in expected], rtol=1e-12)
+    assert np.allclose(phd.m, [e[2] for e in expected]) and np.allclose(phd.P, [e[3] for e in expected])
 
 
 def test_lmb_end_to_end_through_gym_make_is_reproducible_and_needs_the_image_size():

@@ -103,3 +103,26 @@ class Innovation:
     def corrected_means(self, m: np.ndarray, z: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Means of components `rows` corrected by measurements `cols` (pairs)."""
         return m[rows] + np.einsum("nij,nj->ni", self.K[rows], z[cols] - self.eta[rows])
+
+
+def within_distance(m: np.ndarray, P: np.ndarray, limit: float) -> list[np.ndarray]:
+    """For each component k, the components n (k among them) with (m_n - m_k)' P_k^-1 (m_n - m_k) <= limit.
+
+    Only pairs whose x and y each lie within the bound are tested: a Mahalanobis distance is at least that of any
+    one coordinate alone, dx^2 / P_k[x, x]. A sweep over the components sorted by x finds them in O(n log n + pairs).
+    """
+    n = len(m)
+    reach = np.sqrt(limit * np.maximum(P[:, [0, 1], [0, 1]], 0))  # (n, 2): how far in x and in y k can reach
+    order = np.argsort(m[:, 0], kind="stable")
+    xs = m[order, 0]
+    lo = np.searchsorted(xs, m[:, 0] - reach[:, 0], side="left")
+    hi = np.searchsorted(xs, m[:, 0] + reach[:, 0], side="right")
+    k = np.repeat(np.arange(n), hi - lo)
+    cand = order[np.arange(len(k)) - np.repeat(np.cumsum(hi - lo) - (hi - lo) - lo, hi - lo)]
+    ok = np.abs(m[cand, 1] - m[k, 1]) <= reach[k, 1]
+    k, cand = k[ok], cand[ok]
+    d = m[cand] - m[k]
+    close = np.einsum("pi,pij,pj->p", d, np.linalg.inv(P)[k], d) <= limit
+    k, cand = k[close], cand[close]
+    by_k = np.lexsort((cand, k))
+    return np.split(cand[by_k], np.searchsorted(k[by_k], np.arange(1, n)))

@@ -92,23 +92,42 @@ class GaussianMixturePhd(Tracker):
         w, m, P, label = w[keep], m[keep], P[keep], label[keep]
         order = np.argsort(-w, kind="stable")
         w, m, P, label = w[order], m[order], P[order], label[order]
-        open_ = np.ones(len(w), bool)
-        out_w, out_m, out_P, out_label = [], [], [], []
-        while open_.any() and len(out_w) < p["max_components"]:
-            k = int(np.argmax(open_))   # the heaviest open component (sorted)
-            d = m[open_] - m[k]
-            near = np.flatnonzero(open_)[np.einsum("ni,ij,nj->n", d, np.linalg.inv(P[k]), d) <= p["merge"]]
-            wn = w[near]
-            total = wn.sum()
-            mean = wn @ m[near] / total
-            spread = m[near] - mean
-            cov = (np.einsum("n,nij->ij", wn, P[near]) + np.einsum("n,ni,nj->ij", wn, spread, spread)) / total
-            out_w.append(total)
-            out_m.append(mean)
-            out_P.append(cov)
-            out_label.append(label[k])
-            open_[near] = False
-        order = np.argsort(-np.array(out_w), kind="stable")
-        self.w, self.label = np.array(out_w)[order], np.array(out_label, np.int64)[order]
-        self.m = np.array(out_m).reshape(-1, gm.DIM)[order]
-        self.P = np.array(out_P).reshape(-1, gm.DIM, gm.DIM)[order]
+        near = gm.within_distance(m, P, p["merge"])
+        head_of = np.full(len(w), -1)
+        heads = []
+        for k in range(len(w)):  # the heaviest open component takes its open neighbours (itself among them)
+            if head_of[k] >= 0:
+                continue
+            if len(heads) == p["max_components"]:
+                break
+            members = near[k][head_of[near[k]] < 0]
+            head_of[members] = len(heads)
+            heads.append(k)
+        heads = np.array(heads, np.int64)
+        total, mean, cov = merge_clusters(w, m, P, head_of, len(heads))
+        order = np.argsort(-total, kind="stable")
+        self.w, self.label = total[order], label[heads][order]
+        self.m = mean.reshape(-1, gm.DIM)[order]
+        self.P = cov.reshape(-1, gm.DIM, gm.DIM)[order]
+
+
+def merge_clusters(w, m, P, cluster, count):
+    """Weight, mean and covariance of each of `count` clusters of weighted Gaussians (cluster index -1: dropped).
+    Clusters of one are copied through the same arithmetic at once; larger ones are summed one by one in the
+    order the filter always used, so results stay identical to the bit."""
+    total, mean, cov = np.zeros(count), np.zeros((count, gm.DIM)), np.zeros((count, gm.DIM, gm.DIM))
+    size = np.bincount(cluster[cluster >= 0], minlength=count)
+    alone = np.flatnonzero((cluster >= 0) & (size[np.maximum(cluster, 0)] == 1))
+    c, wa = cluster[alone], w[alone]
+    total[c] = wa
+    mean[c] = wa[:, None] * m[alone] / wa[:, None]
+    spread = m[alone] - mean[c]
+    cov[c] = (wa[:, None, None] * P[alone] + wa[:, None, None] * spread[:, :, None] * spread[:, None, :]) / wa[:, None, None]
+    for c in np.flatnonzero(size > 1).tolist():
+        near = np.flatnonzero(cluster == c)
+        wn = w[near]
+        total[c] = wn.sum()
+        mean[c] = wn @ m[near] / total[c]
+        spread = m[near] - mean[c]
+        cov[c] = (np.einsum("n,nij->ij", wn, P[near]) + np.einsum("n,ni,nj->ij", wn, spread, spread)) / total[c]
+    return total, mean, cov
