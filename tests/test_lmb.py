@@ -186,6 +186,16 @@ def test_within_distance_finds_exactly_the_pairs_brute_force_finds(seed, n, limi
     assert [sorted(c.tolist()) for c in near] == [np.flatnonzero(row).tolist() for row in brute]
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 30), st.integers(0, 30), st.booleans())
+def test_gated_distances_are_the_full_distances_inside_the_gate(seed, n, m, axis_aligned):
+    _, means, P = random_mixture(seed, n, axis_aligned)
+    z = np.random.default_rng(seed).uniform(0, 200, (m, gm.MEAS))
+    inn = gm.Innovation.of(means, P, gm.BoxNoise())
+    full, gate = inn.distance2(z), 9.49
+    assert np.array_equal(inn.distance2(z, gate), np.where(full < gate, full, np.inf))
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 10**6), st.integers(1, 40), st.integers(1, 12))
 def test_gmphd_merge_is_vo_and_mas_greedy_merge(seed, n, cap):

@@ -103,8 +103,11 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
         total, _, cols, node = heapq.heappop(heap)
         out.append((cols, total))
         forced = node.copy()
+        # row i's open columns once rows 0..i-1 are forced: its own, less those that rows 0..i-1 took
+        finite = np.isfinite(node)
+        alternatives = (finite.sum(axis=1) - np.tril(finite[:, cols], -1).sum(axis=1)).tolist()
         for i in range(n):
-            if np.isfinite(forced[i]).sum() > 1:  # a row already forced to one column has no alternative
+            if alternatives[i] > 1:  # a row with one open column (forced, or left so) has no alternative
                 child = forced.copy()
                 child[i, cols[i]] = np.inf
                 sol = _best(child)

@@ -80,6 +80,7 @@ class Innovation:
 
     eta: np.ndarray      # (n, 4)
     S_inv: np.ndarray    # (n, 4, 4)
+    S_diag: np.ndarray   # (n, 4): variances of the predicted measurement
     log_norm: np.ndarray  # (n,): log of the Gaussian's normalising constant
     K: np.ndarray        # (n, 8, 4)
     P: np.ndarray        # (n, 8, 8): covariance after any measurement
@@ -90,12 +91,20 @@ class Innovation:
         S_inv = np.linalg.inv(S)
         K = P @ H.T @ S_inv
         _, logdet = np.linalg.slogdet(S)
-        return cls(m @ H.T, S_inv, -0.5 * (MEAS * np.log(2 * np.pi) + logdet), K, P - K @ H @ P)
+        return cls(m @ H.T, S_inv, np.diagonal(S, axis1=1, axis2=2), -0.5 * (MEAS * np.log(2 * np.pi) + logdet), K,
+                   P - K @ H @ P)
 
-    def distance2(self, z: np.ndarray) -> np.ndarray:
-        """(n, M) squared Mahalanobis distances of measurements z (M, 4)."""
-        d = z[None, :, :] - self.eta[:, None, :]
-        return np.einsum("nmi,nij,nmj->nm", d, self.S_inv, d)
+    def distance2(self, z: np.ndarray, gate: float = np.inf) -> np.ndarray:
+        """(n, M) squared Mahalanobis distances of measurements z (M, 4); with a gate, inf for the pairs beyond it
+        (only pairs within the gate in x and in y alone are computed, see `near_in_x_and_y`)."""
+        if np.isinf(gate):
+            d = z[None, :, :] - self.eta[:, None, :]
+            return np.einsum("nmi,nij,nmj->nm", d, self.S_inv, d)
+        out = np.full((len(self.eta), len(z)), np.inf)
+        k, j = near_in_x_and_y(self.eta[:, :2], np.sqrt(gate * self.S_diag[:, :2]), z[:, :2])
+        d = z[j] - self.eta[k]
+        out[k, j] = np.einsum("pi,pij,pj->p", d, self.S_inv[k], d)
+        return np.where(out < gate, out, np.inf)
 
     def log_likelihood(self, distance2: np.ndarray) -> np.ndarray:
         return self.log_norm[:, None] - 0.5 * distance2
@@ -105,24 +114,28 @@ class Innovation:
         return m[rows] + np.einsum("nij,nj->ni", self.K[rows], z[cols] - self.eta[rows])
 
 
-def within_distance(m: np.ndarray, P: np.ndarray, limit: float) -> list[np.ndarray]:
-    """For each component k, the components n (k among them) with (m_n - m_k)' P_k^-1 (m_n - m_k) <= limit.
+def near_in_x_and_y(centre: np.ndarray, reach: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs (k, j) with |points[j] - centre[k]| <= reach[k] in x and in y; centre, reach (n, 2), points (M, 2).
 
-    Only pairs whose x and y each lie within the bound are tested: a Mahalanobis distance is at least that of any
-    one coordinate alone, dx^2 / P_k[x, x]. A sweep over the components sorted by x finds them in O(n log n + pairs).
+    A squared Mahalanobis distance is at least that of one coordinate alone, dx^2 / var_x: with reach
+    sqrt(limit var) these pairs hold every pair within `limit`. A sweep over the points sorted by x finds them in
+    O((n + M) log M + pairs) instead of n x M.
     """
-    n = len(m)
-    reach = np.sqrt(limit * np.maximum(P[:, [0, 1], [0, 1]], 0))  # (n, 2): how far in x and in y k can reach
-    order = np.argsort(m[:, 0], kind="stable")
-    xs = m[order, 0]
-    lo = np.searchsorted(xs, m[:, 0] - reach[:, 0], side="left")
-    hi = np.searchsorted(xs, m[:, 0] + reach[:, 0], side="right")
-    k = np.repeat(np.arange(n), hi - lo)
-    cand = order[np.arange(len(k)) - np.repeat(np.cumsum(hi - lo) - (hi - lo) - lo, hi - lo)]
-    ok = np.abs(m[cand, 1] - m[k, 1]) <= reach[k, 1]
-    k, cand = k[ok], cand[ok]
+    order = np.argsort(points[:, 0], kind="stable")
+    xs = points[order, 0]
+    lo = np.searchsorted(xs, centre[:, 0] - reach[:, 0], side="left")
+    count = np.searchsorted(xs, centre[:, 0] + reach[:, 0], side="right") - lo
+    k = np.repeat(np.arange(len(centre)), count)
+    j = order[np.arange(len(k)) - np.repeat(np.cumsum(count) - count - lo, count)]
+    ok = np.abs(points[j, 1] - centre[k, 1]) <= reach[k, 1]
+    return k[ok], j[ok]
+
+
+def within_distance(m: np.ndarray, P: np.ndarray, limit: float) -> list[np.ndarray]:
+    """For each component k, the components n (k among them) with (m_n - m_k)' P_k^-1 (m_n - m_k) <= limit."""
+    k, cand = near_in_x_and_y(m[:, :2], np.sqrt(limit * np.maximum(P[:, [0, 1], [0, 1]], 0)), m[:, :2])
     d = m[cand] - m[k]
     close = np.einsum("pi,pij,pj->p", d, np.linalg.inv(P)[k], d) <= limit
     k, cand = k[close], cand[close]
     by_k = np.lexsort((cand, k))
-    return np.split(cand[by_k], np.searchsorted(k[by_k], np.arange(1, n)))
+    return np.split(cand[by_k], np.searchsorted(k[by_k], np.arange(1, len(m))))

@@ -63,8 +63,8 @@ class GaussianMixturePhd(Tracker):
         m, P = np.r_[m, bm], np.concatenate([P, bP])
 
         inn = gm.Innovation.of(m, P, self.noise)
-        d2 = inn.distance2(z)
-        gated = d2 < chi2_gate(gm.MEAS, p["gate"])
+        d2 = inn.distance2(z, chi2_gate(gm.MEAS, p["gate"]))
+        gated = np.isfinite(d2)
         like = np.where(gated, pd * w[:, None] * np.exp(inn.log_likelihood(d2)), 0.0)  # (C, M)
         share = like / (self.clutter_density + like.sum(axis=0))
         c, j = np.nonzero(share > p["prune"])

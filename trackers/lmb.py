@@ -209,8 +209,8 @@ class LabelledMultiBernoulli(Tracker):
         self._births(dets)
 
         inn = gm.Innovation.of(t.m, t.P, self.noise)
-        d2 = inn.distance2(z)
-        gated_c = d2 < chi2_gate(gm.MEAS, p["gate"])
+        d2 = inn.distance2(z, chi2_gate(gm.MEAS, p["gate"]))
+        gated_c = np.isfinite(d2)
         log_l = np.where(gated_c, np.log(t.w)[:, None] + inn.log_likelihood(d2), -np.inf)   # (C, M)
         n_tracks, n_meas = len(t.r), len(z)
         log_q = np.full((n_tracks, n_meas), -np.inf)                                       # log q_i(z_j) per track
