@@ -1,8 +1,10 @@
-"""`mtt-sim perf`: env, metrics, JPDA and particle-filter throughput, each with a same-run reference.
+"""`mtt-sim perf`: env, metrics and tracker throughput, each with a same-run reference.
 
-Env reference: the least any frame-producing step must do, copying a background of the same size
-and drawing the same N filled ellipses with OpenCV. Metrics reference: the least a CLEAR update
-must do, one IoU matrix and one Hungarian assignment per frame. Figures are medians over repeats.
+Env reference: the least any step must do to give a frame and its ground truth, copying a background of the
+same size and drawing the same targets as filled ellipses into the frame and into a uint16 label map. Metrics
+reference: the least a CLEAR update must do, one IoU matrix and one Hungarian assignment per frame. Trackers:
+tracker time alone on recorded observations, against gnn on the same detections or a per-particle cv2.calcHist.
+Figures are medians over repeats.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import statistics
 import time
 import tracemalloc
+from collections import Counter
+from unittest import mock
 
 import cv2
 import numpy as np
@@ -17,38 +21,48 @@ from scipy.optimize import linear_sum_assignment
 
 import trackers
 
+from . import env as env_module
+from . import experiment, scenario
 from .env import NO_TRACKS, TrackingEnv
 from .metrics import EpisodeMetrics, box_iou
 
 SIZE = (640, 480)
 
 
-def _env(n: int, obs_mode: str) -> TrackingEnv:
-    return TrackingEnv("dense", config={"groups.0.count": n, "render.width": SIZE[0], "render.height": SIZE[1],
-                                        "env.obs_mode": obs_mode, "env.max_steps": 10**6})
+def _env(n: int, obs_mode: str, size: tuple[int, int] = SIZE) -> TrackingEnv:
+    """`dense` with n targets on a size[0] x size[1] image; above 200 targets the blobs shrink so that they cover
+    the same share of the image (the physics of a jammed box would measure something else)."""
+    side = max(14.0 * min(1.0, (200 / n) ** 0.5), 4.0)
+    return TrackingEnv("dense", config={"groups.0.count": n, "groups.0.size": [side, side], "render.width": size[0],
+                                        "render.height": size[1], "env.obs_mode": obs_mode, "env.max_steps": 10**6,
+                                        "sensor.max_detections": max(256, 2 * n), "env.max_tracks": max(256, 2 * n)})
 
 
 def _steps_per_second(env: TrackingEnv, steps: int) -> float:
     env.reset(seed=0)
     start = time.perf_counter()
     for _ in range(steps):
-        env.step(NO_TRACKS)
+        if env.step(NO_TRACKS)[2]:  # a scenario whose world ends starts again
+            env.reset(seed=0)
     return steps / (time.perf_counter() - start)
 
 
 def _reference_per_second(env: TrackingEnv, steps: int) -> float:
-    """Copy the env's background and draw its current targets as filled ellipses, `steps` times."""
+    """Copy the env's background and draw its current targets as filled ellipses into a frame and into a uint16
+    label map, `steps` times."""
     env.reset(seed=0)
-    background = env.renderer.canvas[: SIZE[1], : SIZE[0]].copy()
+    h, w = env.renderer.shape
+    background = env.renderer.canvas[:h, :w].copy()
     boxes = env.renderer.image_boxes(env.world)
     centers = np.round((boxes[:, :2] + boxes[:, 2:] / 2) * 16).astype(int).tolist()
     axes = np.maximum(np.round(boxes[:, 2:] / 2 * 16), 1).astype(int).tolist()
     colors = env.world.color.tolist()
     start = time.perf_counter()
     for _ in range(steps):
-        frame = background.copy()
-        for c, a, col in zip(centers, axes, colors):
+        frame, labels = background.copy(), np.zeros((h, w), np.uint16)
+        for i, (c, a, col) in enumerate(zip(centers, axes, colors)):
             cv2.ellipse(frame, c, a, 0, 0, 360, col, -1, cv2.LINE_8, 4)
+            cv2.ellipse(labels, c, a, 0, 0, 360, i + 1, -1, cv2.LINE_8, 4)
     return steps / (time.perf_counter() - start)
 
 
@@ -68,11 +82,98 @@ def measure(repeats: int = 5, steps: int = 200) -> list[dict]:
 
 def report(rows: list[dict]) -> str:
     """Markdown table of `measure`'s rows."""
-    out = [f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians",
+    out = [f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background copy and "
+           "two filled ellipses per target (frame and label map)",
            "| targets | steps/s with frames | steps/s detections only | reference frames/s | step / reference |",
            "|---:|---:|---:|---:|---:|"]
     out += [f"| {r['targets']} | {r['frames_steps_per_s']:.0f} | {r['detections_steps_per_s']:.0f} | "
             f"{r['reference_per_s']:.0f} | {r['step_over_reference']:.2f}x |" for r in rows]
+    return "\n".join(out)
+
+
+def measure_scenarios(repeats: int = 5, steps: int = 200) -> list[dict]:
+    """Every shipped scenario's steps/s with frames (seed 0, no tracks), against the reference drawing its own
+    targets of the first frame."""
+    rows = []
+    for key in sorted(scenario.available()):
+        env = TrackingEnv(key, config={"env.max_steps": 10**6})
+        runs = [(_steps_per_second(env, steps), _reference_per_second(env, steps)) for _ in range(repeats)]
+        fps, ref = (statistics.median(r[i] for r in runs) for i in range(2))
+        h, w = env.renderer.shape
+        rows.append({"scenario": key, "image": f"{w}x{h}", "targets": len(env.world.ids), "steps_per_s": fps,
+                     "reference_per_s": ref, "step_over_reference": ref / fps})
+    return rows
+
+
+def report_scenarios(rows: list[dict]) -> str:
+    out = ["env step throughput per scenario with frames and detections, medians (reference: as above, its own "
+           "targets of the first frame)",
+           "| scenario | image | targets (first frame) | steps/s | reference frames/s | step / reference |",
+           "|---|---|---:|---:|---:|---:|"]
+    out += [f"| {r['scenario']} | {r['image']} | {r['targets']} | {r['steps_per_s']:.0f} | {r['reference_per_s']:.0f} | "
+            f"{r['step_over_reference']:.2f}x |" for r in rows]
+    return "\n".join(out)
+
+
+STAGES = ("world", "render", "truth", "detector", "scoring", "other")
+
+
+def _stage_seconds(env: TrackingEnv, steps: int) -> dict[str, float]:
+    """Seconds per step of each stage of env.step, timed by wrapping the env's parts: the world's physics and motion,
+    the renderer (frame and label map), the truth's visibility, the detector, the scoring and the rest."""
+    spent: Counter = Counter()
+
+    def timed(name, fn):
+        def run(*args, **kwargs):
+            start = time.perf_counter()
+            out = fn(*args, **kwargs)
+            spent[name] += time.perf_counter() - start
+            return out
+        return run
+
+    env.reset(seed=0)
+    env.world.step = timed("world", env.world.step)
+    env.renderer.render = timed("render", env.renderer.render)
+    env.sensor.detect = timed("detector", env.sensor.detect)
+    env.metrics.update = timed("scoring", env.metrics.update)
+    with mock.patch.object(env_module, "measure", timed("truth", env_module.measure)):
+        start = time.perf_counter()
+        for _ in range(steps):
+            env.step(NO_TRACKS)
+        total = time.perf_counter() - start
+    spent["other"] = total - sum(spent.values())
+    return {name: spent[name] / steps for name in STAGES} | {"total": total / steps}
+
+
+def measure_scaling(repeats: int = 5, steps: int = 100) -> list[dict]:
+    """Milliseconds per step of each stage, medians, at 20, 200 and 2000 targets on 640x480 and 1920x1080 frames."""
+    rows = []
+    for size in (SIZE, (1920, 1080)):
+        for n in (20, 200, 2000):
+            env = _env(n, "frame+detections", size)
+            runs = [_stage_seconds(env, max(int(steps * (20 / n) ** 0.5), 10)) for _ in range(repeats)]
+            rows.append({"targets": n, "image": f"{size[0]}x{size[1]}", "pixels": size[0] * size[1],
+                         **{k: statistics.median(r[k] for r in runs) * 1e3 for k in (*STAGES, "total")}})
+    return rows
+
+
+def _growth(rows: list[dict], a: dict, b: dict) -> str:
+    """Each stage's cost ratio from row a to row b."""
+    return ", ".join(f"{k} {b[k] / a[k]:.1f}x" for k in (*STAGES, "total") if a[k] > 0)
+
+
+def report_scaling(rows: list[dict]) -> str:
+    out = ["env step cost by stage, milliseconds per step with frames, medians ('dense'; above 200 targets the blobs "
+           "shrink to keep the share of the image they cover)",
+           "| targets | image | steps/s | " + " | ".join(STAGES) + " |", "|---:|---|---:|" + "---:|" * len(STAGES)]
+    out += [f"| {r['targets']} | {r['image']} | {1e3 / r['total']:.0f} | " + " | ".join(f"{r[k]:.2f}" for k in STAGES)
+            + " |" for r in rows]
+    by = {(r["targets"], r["image"]): r for r in rows}
+    small, large = f"{SIZE[0]}x{SIZE[1]}", "1920x1080"
+    pixels = by[(200, large)]["pixels"] / by[(200, small)]["pixels"]
+    out += [f"growth, 200 -> 2000 targets (10x) at {small}: " + _growth(rows, by[(200, small)], by[(2000, small)]),
+            f"growth, {small} -> {large} ({pixels:.2f}x the pixels) at 200 targets: "
+            + _growth(rows, by[(200, small)], by[(200, large)])]
     return "\n".join(out)
 
 
@@ -206,6 +307,35 @@ def report_lmb(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
+RFS_WORKLOADS = (("mot17_like", {}, ("gmphd",)),
+                 ("dense", {"groups.0.count": 100, "sensor.pd": 0.9, "sensor.clutter_rate": 10.0},
+                  ("gmphd", "lmb:reid=false", "lmb")))
+
+
+def measure_rfs(repeats: int = 5, frames: int = 100) -> list[dict]:
+    """Medians of the random-finite-set trackers' milliseconds per frame (tracker time only) on scenarios: gmphd on
+    mot17_like; gmphd and lmb on dense with 100 targets, P_D 0.9 and 10 clutter a frame; each against gnn."""
+    rows = []
+    for key, config, specs in RFS_WORKLOADS:
+        rec = _recorded(key, frames, config)
+        runs = [[_ms_per_frame(spec, rec) for spec in (*specs, "gnn")] for _ in range(repeats)]
+        gnn = statistics.median(r[-1] for r in runs)
+        setting = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in config.items())
+        for i, spec in enumerate(specs):
+            ms = statistics.median(r[i] for r in runs)
+            rows.append({"tracker": spec, "workload": key + (f" ({setting})" if setting else ""), "ms": ms,
+                         "gnn_ms": gnn, "over_gnn": ms / gnn})
+    return rows
+
+
+def report_rfs(rows: list[dict]) -> str:
+    out = ["random-finite-set trackers on scenarios, tracker time only, medians (reference: gnn on the same detections)",
+           "| tracker | workload | ms/frame | frames/s | gnn ms/frame | tracker / gnn |", "|---|---|---:|---:|---:|---:|"]
+    out += [f"| {r['tracker']} | {r['workload']} | {r['ms']:.2f} | {1e3 / r['ms']:.0f} | {r['gnn_ms']:.2f} | "
+            f"{r['over_gnn']:.2f}x |" for r in rows]
+    return "\n".join(out)
+
+
 def _recorded(scenario: str, frames: int, config: dict | None = None,
               obs_mode: str = "frame+detections") -> tuple[dict, list[dict]]:
     """env.reset's info and `frames` observations of `scenario` (seed 0, no tracks), for timing trackers alone."""
@@ -219,10 +349,10 @@ def _recorded(scenario: str, frames: int, config: dict | None = None,
 
 
 def _particle_filter_row(label: str, spec: str, scenario: str, targets: int, particles: int, reference, repeats: int,
-                         frames: int) -> dict:
+                         frames: int, config: dict | None = None) -> dict:
     """Frames per second of `spec` on the first `targets` hand-initialised targets, against `reference(obs, boxes)`:
     the per-particle way, one cv2.calcHist call per particle region."""
-    info, recorded = _recorded(scenario, frames)
+    info, recorded = _recorded(scenario, frames, config)
     first = {"init_ids": info["init_ids"][:targets], "init_boxes": info["init_boxes"][:targets]}
     boxes = np.round(first["init_boxes"]).astype(int)
 
@@ -238,7 +368,7 @@ def _particle_filter_row(label: str, spec: str, scenario: str, targets: int, par
 
     runs = [(frames / _time(tracker_run), frames / _time(per_particle)) for _ in range(repeats)]
     fps, ref = (statistics.median(r[i] for r in runs) for i in range(2))
-    return {"tracker": label, "fps": fps, "reference_fps": ref}
+    return {"tracker": label.format(targets=len(boxes)), "fps": fps, "reference_fps": ref}
 
 
 def _rgb_calchist(frame, boxes, particles):
@@ -254,14 +384,22 @@ def _hs_calchist(frame, boxes, particles):
             cv2.calcHist([hsv[y:y + h, x:x + w]], [0, 1], None, [16, 16], [0, 180, 0, 256])
 
 
+CROWD = {"groups.0.count": 30, "groups.1.count": 10}  # mot17_like with at least 30 people in the first frame
+
+
 def measure_pf(repeats: int = 5, frames: int = 60) -> list[dict]:
     """The particle filters' frames per second (tracker time only): pf with one target and 60 particles on 768x576
-    umbrella frames, ipf with 4 books x 100 particles on 640x480; each against one cv2.calcHist per particle of
-    its histogram alone (RGB 16^3 for pf, H-S 16x16 for ipf)."""
+    umbrella frames, ipf with 4 books x 100 particles on 640x480, and both with 30 people of mot17_like (960x540);
+    each against one cv2.calcHist per particle of its histogram alone (RGB 16^3 for pf, H-S 16x16 for ipf)."""
+    crowd = max(frames // 4, 2)
     return [_particle_filter_row("pf (Li et al. 2007), 1 x 60 particles, 768x576", "pf", "umbrellas", 1, 60,
                                  _rgb_calchist, repeats, frames),
             _particle_filter_row("ipf (Liu et al. 2011), 4 x 100 particles, 640x480", "ipf", "books", 4, 100,
-                                 _hs_calchist, repeats, frames)]
+                                 _hs_calchist, repeats, frames),
+            _particle_filter_row("pf, {targets} x 60 particles, mot17_like 960x540", "pf", "mot17_like", 30, 60,
+                                 _rgb_calchist, repeats, crowd, CROWD),
+            _particle_filter_row("ipf, {targets} x 100 particles, mot17_like 960x540", "ipf", "mot17_like", 30, 100,
+                                 _hs_calchist, repeats, crowd, CROWD)]
 
 
 def report_pf(rows: list[dict]) -> str:
@@ -271,3 +409,24 @@ def report_pf(rows: list[dict]) -> str:
     lines += [f"| {r['tracker']} | {r['fps']:.0f} | {r['reference_fps']:.0f} | {r['fps'] / r['reference_fps']:.2f}x |"
               for r in rows]
     return "\n".join(lines)
+
+
+SWEEP = (("sort", "gnn"), ("crossing", "soccer", "mot17_like"), 2)  # trackers, scenarios, seeds: 12 full episodes
+
+
+def measure_sweeps(repeats: int = 3, config: dict | None = None) -> dict:
+    """Medians of the wall time of one `bench` grid (SWEEP, with `config` overrides) on one worker and on two local
+    worker processes (at most 3 repeats: a grid takes a minute)."""
+    specs, scenarios, seeds = SWEEP
+    runs = [[_time(lambda: experiment.run_grid(specs, scenarios, seeds, config, workers=w)) for w in (1, 2)]
+            for _ in range(min(repeats, 3))]
+    one, two = (statistics.median(r[i] for r in runs) for i in range(2))
+    return {"episodes": len(specs) * len(scenarios) * seeds, "one_s": one, "two_s": two, "speedup": one / two}
+
+
+def report_sweeps(row: dict) -> str:
+    specs, scenarios, seeds = SWEEP
+    return "\n".join([f"bench grid ({', '.join(specs)} on {', '.join(scenarios)}, {seeds} seeds: {row['episodes']} "
+                      "episodes), wall time, medians",
+                      "| 1 worker | 2 workers | speed-up |", "|---:|---:|---:|",
+                      f"| {row['one_s']:.1f} s | {row['two_s']:.1f} s | {row['speedup']:.2f}x |"])

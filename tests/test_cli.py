@@ -225,8 +225,27 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert 0 < row["kb_per_frame"] < 5 and row["summary_s"] > 0 and 1 <= row["peak_over_stored"] < 4
     assert "stored per frame" in perf.report_metrics_memory(row)
     rows = perf.measure_pf(repeats=1, frames=2)
-    assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf"] and all(r["fps"] > 0 for r in rows)
+    assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf", "pf,", "ipf,"] and all(r["fps"] > 0 for r in rows)
     assert "| ipf (Liu et al. 2011), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
+    assert "| ipf, 30 x 100 particles, mot17_like 960x540 |" in perf.report_pf(rows)
+
+
+def test_perf_tables_of_scenarios_scaling_rfs_trackers_and_sweeps():
+    rows = perf.measure_scenarios(repeats=1, steps=2)
+    assert {r["scenario"] for r in rows} == set(scenario.available()) and all(r["steps_per_s"] > 0 for r in rows)
+    assert "| mot17_like | 960x540 |" in perf.report_scenarios(rows)
+    rows = perf.measure_scaling(repeats=1, steps=1)
+    assert [(r["targets"], r["image"]) for r in rows] == [(n, size) for size in ("640x480", "1920x1080")
+                                                          for n in (20, 200, 2000)]
+    assert all(abs(sum(r[k] for k in perf.STAGES) - r["total"]) < 1e-9 and min(r[k] for k in perf.STAGES) >= 0
+               for r in rows if r["other"] >= 0)
+    assert "growth, 200 -> 2000 targets (10x) at 640x480: world" in perf.report_scaling(rows)
+    rows = perf.measure_rfs(repeats=1, frames=3)
+    assert [r["tracker"] for r in rows] == ["gmphd", "gmphd", "lmb:reid=false", "lmb"] and all(r["ms"] > 0 for r in rows)
+    assert "| gmphd | mot17_like |" in perf.report_rfs(rows)
+    row = perf.measure_sweeps(repeats=1, config={"env.max_steps": 3})
+    assert row["episodes"] == 12 and row["one_s"] > 0 and row["two_s"] > 0
+    assert "| 1 worker | 2 workers | speed-up |" in perf.report_sweeps(row)
 
 
 def test_sweep_and_bench_plot_one_panel_per_metric(tmp_path, capsys):
@@ -258,7 +277,7 @@ def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
             monkeypatch.setattr(perf, name, lambda measured: f"table of {measured}")
     assert cli.main(["perf", "--repeats", "1"]) == 0
     captured = capsys.readouterr()
-    assert captured.out.count("table of measure") == 6 and "measuring" in captured.err
+    assert captured.out.count("table of measure") == 10 and "measuring" in captured.err
 
 
 def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
