@@ -5,6 +5,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import trackers
 from helpers import run_tracker, tiny
@@ -26,20 +28,21 @@ def test_conflict_set_on_hand_placed_regions():
     assert conflict_set(shifted, sizes, 0.75)[:, 0].tolist() == [False, False, True]  # target 2 still inside 1's
 
 
-@pytest.mark.parametrize("seed", range(5))
-def test_conflict_set_equals_the_plain_pair_loop(seed):
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 6), st.integers(1, 12), st.floats(0.05, 1.0), st.booleans())
+def test_conflict_set_equals_the_plain_pair_loop(seed, k, n, ratio, whole_pixels):
     rng = np.random.default_rng(seed)
-    k, n = 4, 6
-    sizes = rng.uniform(5, 30, (k, 2))
-    centres = rng.uniform(0, 60, (k, 1, 2)) + rng.normal(0, 8, (k, n, 2))
+    sizes = rng.uniform(4, 30, (k, 2))
+    sizes = np.round(sizes) if whole_pixels else sizes
+    centres = rng.uniform(0, 40, (k, 1, 2)) + rng.normal(0, 6, (k, n, 2))
     expected = np.zeros((k, n), bool)
     for a, i, b, j in itertools.product(range(k), range(n), range(k), range(n)):
         if a != b:
             lo = np.maximum(centres[a, i] - sizes[a] / 2, centres[b, j] - sizes[b] / 2)
             hi = np.minimum(centres[a, i] + sizes[a] / 2, centres[b, j] + sizes[b] / 2)
             inter = np.prod(np.clip(hi - lo, 0, None))
-            expected[a, i] |= inter / min(np.prod(sizes[a]), np.prod(sizes[b])) > 0.5
-    np.testing.assert_array_equal(conflict_set(centres, sizes, 0.5), expected)
+            expected[a, i] |= inter > ratio * min(np.prod(sizes[a]), np.prod(sizes[b]))
+    np.testing.assert_array_equal(conflict_set(centres, sizes, ratio), expected)
 
 
 def test_runs_and_is_reproducible_with_and_without_interaction():

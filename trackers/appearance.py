@@ -29,23 +29,28 @@ def hs_bins(frame: np.ndarray, h_levels: int = 8, s_levels: int = 8) -> np.ndarr
 
 def _region_pixels(centres: np.ndarray, size: tuple[int, int], shape: tuple[int, int], stride: int = 1):
     """Flat image index of every `stride`-th pixel (rows and columns) of every w x h region (n, h', w'), and
-    whether it lies inside the image."""
+    whether it lies inside the image (None when every region lies wholly inside: then one region's offsets plus
+    each region's corner are the indices, two passes over the pixels instead of eight)."""
     w, h = size
     x0 = np.round(centres[:, 0] - w / 2).astype(np.intp)
     y0 = np.round(centres[:, 1] - h / 2).astype(np.intp)
-    rows = y0[:, None, None] + np.arange(0, h, stride)[None, :, None]  # (n, h', 1)
-    cols = x0[:, None, None] + np.arange(0, w, stride)[None, None, :]  # (n, 1, w')
+    dy, dx = np.arange(0, h, stride), np.arange(0, w, stride)
+    if len(x0) and x0.min() >= 0 and y0.min() >= 0 and x0.max() + dx[-1] < shape[1] and y0.max() + dy[-1] < shape[0]:
+        offsets = dy[:, None] * shape[1] + dx[None, :]
+        return (y0 * shape[1] + x0)[:, None, None] + offsets[None], None
+    rows = y0[:, None, None] + dy[None, :, None]  # (n, h', 1)
+    cols = x0[:, None, None] + dx[None, None, :]  # (n, 1, w')
     inside = ((rows >= 0) & (rows < shape[0])) & ((cols >= 0) & (cols < shape[1]))
     flat = np.clip(rows, 0, shape[0] - 1) * shape[1] + np.clip(cols, 0, shape[1] - 1)
     return flat, inside
 
 
-def _binned(per_pixel_bin: np.ndarray, n_bins: int, flat: np.ndarray, inside: np.ndarray,
+def _binned(per_pixel_bin: np.ndarray, n_bins: int, flat: np.ndarray, inside: np.ndarray | None,
             weights: np.ndarray | None) -> np.ndarray:
-    """Histograms (n, n_bins): region pixels outside the image go to a sentinel bin that is dropped."""
+    """Histograms (n, n_bins): region pixels outside the image (inside False) go to a sentinel bin that is dropped."""
     n = len(flat)
-    b = np.where(inside, per_pixel_bin, n_bins)
-    index = (np.arange(n)[:, None, None] * (n_bins + 1) + b).ravel()
+    b = per_pixel_bin if inside is None else np.where(inside, per_pixel_bin, n_bins)
+    index = (b + (np.arange(n) * (n_bins + 1))[:, None, None]).ravel()
     w = None if weights is None else np.broadcast_to(weights, b.shape).ravel()
     return np.bincount(index, weights=w, minlength=n * (n_bins + 1)).reshape(n, n_bins + 1)[:, :n_bins]
 
@@ -59,6 +64,8 @@ def histograms(bins: np.ndarray, n_bins: int, centres: np.ndarray, size: tuple[i
     """
     flat, inside = _region_pixels(np.asarray(centres, float).reshape(-1, 2), size, bins.shape, stride)
     hist = _binned(bins.ravel().take(flat), n_bins, flat, inside, weights)
+    if inside is None:
+        inside = np.ones((1,) + flat.shape[1:], bool)
     total = (inside * (1.0 if weights is None else weights[None])).sum(axis=(1, 2))
     return hist / np.where(total > 0, total, 1.0)[:, None]
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Param
+from .sweep import near_in_x_and_y
 
 DIM, MEAS = 8, 4
 # the model parameters the LMB and GM-PHD trackers share; noise values chosen on mot17_like seed 100 (not one
@@ -114,25 +115,9 @@ class Innovation:
         return m[rows] + np.einsum("nij,nj->ni", self.K[rows], z[cols] - self.eta[rows])
 
 
-def near_in_x_and_y(centre: np.ndarray, reach: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs (k, j) with |points[j] - centre[k]| <= reach[k] in x and in y; centre, reach (n, 2), points (M, 2).
-
-    A squared Mahalanobis distance is at least that of one coordinate alone, dx^2 / var_x: with reach
-    sqrt(limit var) these pairs hold every pair within `limit`. A sweep over the points sorted by x finds them in
-    O((n + M) log M + pairs) instead of n x M.
-    """
-    order = np.argsort(points[:, 0], kind="stable")
-    xs = points[order, 0]
-    lo = np.searchsorted(xs, centre[:, 0] - reach[:, 0], side="left")
-    count = np.searchsorted(xs, centre[:, 0] + reach[:, 0], side="right") - lo
-    k = np.repeat(np.arange(len(centre)), count)
-    j = order[np.arange(len(k)) - np.repeat(np.cumsum(count) - count - lo, count)]
-    ok = np.abs(points[j, 1] - centre[k, 1]) <= reach[k, 1]
-    return k[ok], j[ok]
-
-
 def within_distance(m: np.ndarray, P: np.ndarray, limit: float) -> list[np.ndarray]:
-    """For each component k, the components n (k among them) with (m_n - m_k)' P_k^-1 (m_n - m_k) <= limit."""
+    """For each component k, the components n (k among them) with (m_n - m_k)' P_k^-1 (m_n - m_k) <= limit
+    (candidates: within the bound in x and in y alone, see `near_in_x_and_y`)."""
     k, cand = near_in_x_and_y(m[:, :2], np.sqrt(limit * np.maximum(P[:, [0, 1], [0, 1]], 0)), m[:, :2])
     d = m[cand] - m[k]
     close = np.einsum("pi,pij,pj->p", d, np.linalg.inv(P)[k], d) <= limit

@@ -7,26 +7,36 @@ import numpy as np
 from .appearance import bhattacharyya, histograms, hs_bins
 from .base import Param, Tracker, Tracks, frame_of, register
 from .particle import crop_around, initial_targets
+from .sweep import near_in_x_and_y
 
 
 def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.ndarray:
     """Eq. 2: which particles (targets, N) overlap a particle of another target by more than `ratio` of the smaller
-    region. Regions are each target's box size centred on its particles. Every particle pair of two targets is
-    compared at once; a pair of targets whose particle clouds lie apart is skipped whole, so the common frame
-    without interaction costs K^2 / 2 box tests rather than (KN)^2 overlaps."""
+    region. Regions are each target's box size centred on its particles. Only particle pairs near enough to pass
+    are compared (a sweep along x, then y), so a crowd costs its near pairs rather than (KN)^2 overlaps."""
     k, n, _ = centres.shape
-    lo, hi = centres - sizes[:, None, :] / 2.0, centres + sizes[:, None, :] / 2.0
+    owner = np.repeat(np.arange(k), n)
+    xy, half = centres.reshape(-1, 2), np.repeat(sizes / 2.0, n, axis=0)
+    a, b = near_in_x_and_y(xy, _reach(sizes, ratio)[owner], xy)
+    a, b = a[owner[a] != owner[b]], b[owner[a] != owner[b]]
+    overlap = np.clip(np.minimum(xy[a] + half[a], xy[b] + half[b]) - np.maximum(xy[a] - half[a], xy[b] - half[b]), 0, None)
     area = np.prod(sizes, axis=1)
-    cloud_lo, cloud_hi = lo.min(axis=1, initial=np.inf), hi.max(axis=1, initial=-np.inf)
-    conflict = np.zeros((k, n), bool)
-    for a, b in zip(*np.triu_indices(k, 1)):
-        if (cloud_lo[a] >= cloud_hi[b]).any() or (cloud_lo[b] >= cloud_hi[a]).any():
-            continue
-        overlap = np.clip(np.minimum(hi[a][:, None], hi[b][None]) - np.maximum(lo[a][:, None], lo[b][None]), 0, None)
-        hit = overlap[..., 0] * overlap[..., 1] > ratio * min(area[a], area[b])
-        conflict[a] |= hit.any(axis=1)
-        conflict[b] |= hit.any(axis=0)
-    return conflict
+    hit = overlap[:, 0] * overlap[:, 1] > ratio * np.minimum(area[owner[a]], area[owner[b]])
+    conflict = np.zeros(k * n, bool)
+    conflict[a[hit]] = True
+    return conflict.reshape(k, n)
+
+
+def _reach(sizes: np.ndarray, ratio: float) -> np.ndarray:
+    """(targets, 2): the largest |dx|, |dy| at which a particle of a target can overlap one of another by more than
+    `ratio` of the smaller region. Overlap in x is at most (w_a + w_b) / 2 - |dx| and in y at most min(h_a, h_b),
+    so the product exceeds ratio min(area) only if |dx| < (w_a + w_b) / 2 - ratio min(area) / min(h_a, h_b)."""
+    w, h = sizes[:, 0], sizes[:, 1]
+    need = ratio * np.minimum.outer(w * h, w * h)
+    reach = np.stack([np.add.outer(w, w) / 2 - need / np.minimum.outer(h, h),
+                      np.add.outer(h, h) / 2 - need / np.minimum.outer(w, w)], axis=-1)  # (K, K, 2)
+    reach[np.arange(len(w)), np.arange(len(w))] = 0.0  # a target's own particles do not conflict
+    return np.maximum(reach.max(axis=1, initial=0.0), 0.0) * (1 + 1e-9) + 1e-9  # rounding: keep every candidate
 
 
 @register
