@@ -91,10 +91,22 @@ class ColourTextureParticleFilter(Tracker):
         return (histograms(bins, self.params["levels"] ** 3, centres, tuple(size)),
                 gradient_descriptors(orient, magnitude, centres, tuple(size)))
 
-    def _likelihood(self, feats, template) -> np.ndarray:
+    def _particle_likelihoods(self, maps, centres: np.ndarray, size, template) -> np.ndarray:
+        """Eq. 8 for every region: colour histograms are counted over the template's nonzero bins alone, the only
+        ones its Bhattacharyya coefficient reads (a few hundred of 4096), so the same coefficients cost far less."""
+        bins, orient, magnitude = maps
+        support = np.flatnonzero(template[0])
+        compact = np.full(self.params["levels"] ** 3, len(support))
+        compact[support] = np.arange(len(support))
+        hist = histograms(compact[bins], len(support) + 1, centres, tuple(size))[:, :-1]
+        return self._likelihood(bhattacharyya(hist, template[0][support]),
+                                gradient_descriptors(orient, magnitude, centres, tuple(size)), template)
+
+    def _likelihood(self, rho: np.ndarray, descriptors: np.ndarray, template) -> np.ndarray:
+        """Eq. 4-8 from the Bhattacharyya coefficients and the texture descriptors of the regions."""
         p = self.params
-        colour = np.exp(-p["lam"] * (1 - bhattacharyya(feats[0], template[0])))
-        texture = np.exp(-p["mu"] * ((feats[1] - template[1][None]) ** 2).sum(axis=1))
+        colour = np.exp(-p["lam"] * (1 - rho))
+        texture = np.exp(-p["mu"] * ((descriptors - template[1][None]) ** 2).sum(axis=1))
         return colour ** p["alpha"] * texture ** (1 - p["alpha"])
 
     def update(self, obs) -> Tracks:
@@ -117,13 +129,12 @@ class ColourTextureParticleFilter(Tracker):
         estimates, scores = np.zeros((k, 4)), np.zeros(k)
         for t in range(k):  # targets differ in region size; every particle of a target is one batched call
             origin, maps = self._maps(frame, self.particles[t, :, :2], self.sizes[t])
-            like = self._likelihood(self._features(maps, self.particles[t, :, :2] - origin, self.sizes[t]),
-                                    self.templates[t])
+            like = self._particle_likelihoods(maps, self.particles[t, :, :2] - origin, self.sizes[t], self.templates[t])
             if like.sum() > 0:
                 weights[t] = like / like.sum()
             estimates[t] = weights[t] @ self.particles[t]
             feats = self._features(maps, estimates[t, None, :2] - origin, self.sizes[t])
-            scores[t] = self._likelihood(feats, self.templates[t])[0]
+            scores[t] = self._likelihood(bhattacharyya(feats[0], self.templates[t][0]), feats[1], self.templates[t])[0]
             if scores[t] > p["update_threshold"]:  # eq. 9-10, only on a confident estimate
                 q, r = self.templates[t]
                 self.templates[t] = (p["beta"] * q + (1 - p["beta"]) * feats[0][0],
