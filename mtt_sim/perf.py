@@ -411,7 +411,7 @@ def report_pf(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-SWEEP = (("sort", "gnn"), ("crossing", "soccer", "mot17_like"), 2)  # trackers, scenarios, seeds: 12 full episodes
+SWEEP = (("sort", "gnn"), ("crossing", "soccer", "mot17_like"), 4)  # trackers, scenarios, seeds: 24 full episodes
 
 
 def measure_sweeps(repeats: int = 3, config: dict | None = None) -> dict:

@@ -244,7 +244,7 @@ def test_perf_tables_of_scenarios_scaling_rfs_trackers_and_sweeps():
     assert [r["tracker"] for r in rows] == ["gmphd", "gmphd", "lmb:reid=false", "lmb"] and all(r["ms"] > 0 for r in rows)
     assert "| gmphd | mot17_like |" in perf.report_rfs(rows)
     row = perf.measure_sweeps(repeats=1, config={"env.max_steps": 3})
-    assert row["episodes"] == 12 and row["one_s"] > 0 and row["two_s"] > 0
+    assert row["episodes"] == 24 and row["one_s"] > 0 and row["two_s"] > 0
     assert "| 1 worker | 2 workers | speed-up |" in perf.report_sweeps(row)
 
 
