@@ -29,9 +29,8 @@ def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility
             if k % every == 0:
                 t = env.truth
                 keep = (t.visibility >= min_visibility) & (t.boxes[:, 3] >= min_height)
-                for crop, target in zip(reid.crops(obs["frame"], t.boxes[keep]), t.ids[keep]):
-                    features.append(reid.lomo(crop))
-                    classes.append(seed * 1_000_000 + int(target))
+                features.extend(reid.lomo(reid.crops(obs["frame"], t.boxes[keep])))
+                classes.extend(seed * 1_000_000 + t.ids[keep].astype(int))
             obs, _, term, trunc, _ = env.step(NO_TRACKS)
             bar.update()
             if term or trunc:

@@ -138,7 +138,7 @@ class Renderer:
 
     def occluder_image_boxes(self) -> np.ndarray:
         """Every occluder's box in image pixels."""
-        return self.occluder_boxes - np.r_[self.camera.offset, 0, 0]
+        return self.occluder_boxes - np.append(self.camera.offset, (0, 0))
 
     def render(self, world: World, draw_frame: bool = True, show_targets: bool = True):
         """(frame or None, labels, image boxes) for the world's current state."""

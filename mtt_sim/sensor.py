@@ -212,7 +212,7 @@ class _Memory:
     def store(self, ids: np.ndarray, state: np.ndarray, drift: np.ndarray, poor: np.ndarray, ease: np.ndarray) -> None:
         """Keep these targets' outcomes; targets absent from this frame are forgotten."""
         order = np.argsort(ids, kind="stable")
-        self.ids, self.state, self.values = ids[order], state[order], np.c_[drift, poor, ease][order]
+        self.ids, self.state, self.values = ids[order], state[order], np.column_stack([drift, poor, ease])[order]
 
 
 class _Sites:
@@ -245,7 +245,7 @@ class _Sites:
         self.shape = np.concatenate([self.shape[keep], shape])
         row = _rows_of(truth.ids, self.owner)
         static = self.owner < 0
-        shown = static | ((row >= 0) & np.r_[visible, False][row])  # row -1 picks the False
+        shown = static | ((row >= 0) & np.append(visible, False)[row])  # row -1 picks the False
         held = shown & ~static
         out = self.shape[shown].copy()
         out[held[shown]] = displace(truth.boxes[row[held]].astype(float), self.shape[held])
@@ -312,8 +312,8 @@ class SyntheticSensor(Sensor):
         np.maximum.at(p, obj, pd[cand])
         area = np.prod(truth.visible_boxes[cand, 2:], axis=1)
         order = np.lexsort((area, obj))
-        return _union(truth.visible_boxes[cand], obj, n_obj), p, cand[order[np.r_[np.flatnonzero(np.diff(obj[order])),
-                                                                                   len(order) - 1]]]
+        return _union(truth.visible_boxes[cand], obj, n_obj), p, cand[order[np.append(np.flatnonzero(np.diff(obj[order])),
+                                                                                     len(order) - 1)]]
 
     def _reports(self, truth: Truth, box: np.ndarray, lead: np.ndarray, hit: np.ndarray, outlier: np.ndarray,
                  single: np.ndarray):
@@ -440,7 +440,7 @@ def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.
     x, y = xy[:, 0], xy[:, 1]
     which = comp[y, x] - 1
     area = np.bincount(which, minlength=count - 1).astype(float)
-    boxes = _union(np.c_[xy, np.ones_like(xy)].astype(float), which, count - 1)
+    boxes = _union(np.concatenate([xy, np.ones_like(xy)], axis=1).astype(float), which, count - 1)
     return area, boxes, np.bincount(which, weights=weights[y, x], minlength=count - 1)
 
 

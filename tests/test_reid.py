@@ -12,7 +12,7 @@ def test_siltp_code_of_a_hand_made_neighbourhood():
     grey = np.full((3, 3), 100.0, np.float32)
     grey[1, 2] = 140.0    # right neighbour brighter than 1.3 x centre: digit 1 at 3^0
     grey[0, 1] = 60.0     # upper neighbour darker than 0.7 x centre: digit 2 at 3^1
-    assert reid._siltp(grey, 1)[1, 1] == 1 * 1 + 2 * 3
+    assert reid._siltp(grey[None], 1)[0, 1, 1] == 1 * 1 + 2 * 3
 
 
 def test_lomo_has_a_fixed_size_unit_parts_and_shrugs_off_lighting():
@@ -22,14 +22,21 @@ def test_lomo_has_a_fixed_size_unit_parts_and_shrugs_off_lighting():
     person[30:] = (40, 40, 160)                     # blue trousers
     person = np.clip(person + rng.normal(0, 6, person.shape), 0, 255).astype(np.uint8)
     other = person[:, :, ::-1].copy()               # the colours swapped
-    f, g = reid.lomo(person), reid.lomo(other)
-    d = reid.lomo((person * 0.6).astype(np.uint8))       # darker: Retinex evens it out
-    s = reid.lomo(np.roll(person, 3, axis=1))              # shifted sideways: the horizontal maximum absorbs it
+    f, g, d, s = reid.lomo([person, other, (person * 0.6).astype(np.uint8),   # darker: Retinex evens it out
+                            np.roll(person, 3, axis=1)])   # shifted sideways: the horizontal maximum absorbs it
     rows = 11 + 5    # rows of 8 x 8 windows, stride 4: 48 x 24 and 24 x 12 (12 x 6 is narrower than a window)
     assert f.shape == g.shape == d.shape == s.shape == (rows * (512 + 2 * 81),)
     colour = rows * 512
     np.testing.assert_allclose([np.linalg.norm(f[:colour]), np.linalg.norm(f[colour:])], 1.0, rtol=1e-5)
     assert max(np.linalg.norm(f - d), np.linalg.norm(f - s)) < 0.5 * np.linalg.norm(f - g)
+
+
+def test_lomo_of_crops_together_is_lomo_of_each_alone():
+    rng = np.random.default_rng(2)
+    crops = [rng.integers(0, 256, (h, w, 3), np.uint8) for h, w in ((60, 24), (33, 17), (120, 50), (2, 2))]
+    together = reid.lomo(crops)
+    assert together.shape == (4, reid._DIM) and reid.lomo([]).shape == (0, reid._DIM)
+    assert all(np.array_equal(together[k], reid.lomo([c])[0]) for k, c in enumerate(crops))
 
 
 def test_xqda_separates_classes_that_differ_only_in_some_directions():

@@ -265,7 +265,7 @@ class LabelledMultiBernoulli(Tracker):
             self.pool.add(self._embed(frame, dets[likely[rows], :4]), t.label[rows])
 
     def _embed(self, frame: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-        return self.metric.embed(np.array([reid.lomo(c) for c in reid.crops(frame, boxes)]))
+        return self.metric.embed(reid.lomo(reid.crops(frame, boxes)))
 
     def _association(self, gated: np.ndarray, log_q: np.ndarray) -> np.ndarray:
         """beta (tracks, measurements + 1) for every group. Every track alone in its group (with no measurement in

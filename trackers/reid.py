@@ -25,51 +25,65 @@ HSV_BINS, TAU = 8, 0.3
 METRIC_FILE = Path(__file__).with_name("data") / "xqda.npz"
 
 
-def retinex(img: np.ndarray, sigmas=(2.0, 8.0)) -> np.ndarray:
-    """Multi-scale Retinex: log image minus log of its blurs, stretched back to 0..255 per channel (uint8)."""
-    f = img.astype(np.float32) + 1.0
-    out = sum(np.log(f) - np.log(cv2.GaussianBlur(f, (0, 0), s)) for s in sigmas) / len(sigmas)
-    lo, hi = out.min(axis=(0, 1)), out.max(axis=(0, 1))
+def retinex(imgs: np.ndarray, sigmas=(2.0, 8.0)) -> np.ndarray:
+    """Multi-scale Retinex of images (k, h, w, 3): log image minus log of its blurs, stretched back to 0..255 per
+    image and channel (uint8)."""
+    f = imgs.astype(np.float32) + 1.0
+    out = sum(np.log(f) - np.log(np.stack([cv2.GaussianBlur(one, (0, 0), s) for one in f])) for s in sigmas) / len(sigmas)
+    pixels = out.reshape(len(out), -1, 3)  # a reduction over one axis: several times faster than over (1, 2)
+    lo, hi = pixels.min(axis=1)[:, None, None], pixels.max(axis=1)[:, None, None]
     return np.clip((out - lo) / np.maximum(hi - lo, 1e-6) * 255, 0, 255).astype(np.uint8)
 
 
 def _siltp(grey: np.ndarray, radius: int) -> np.ndarray:
-    """Per-pixel SILTP code (0..80) from the 4 neighbours at `radius` (edges replicated)."""
-    g = np.pad(grey, radius, mode="edge")
-    h, w = grey.shape
-    centre = g[radius:radius + h, radius:radius + w]
+    """Per-pixel SILTP code (0..80) of images (k, h, w) from the 4 neighbours at `radius` (edges replicated)."""
+    g = np.pad(grey, ((0, 0), (radius, radius), (radius, radius)), mode="edge")
+    h, w = grey.shape[1:]
+    centre = g[:, radius:radius + h, radius:radius + w]
     code = np.zeros(grey.shape, np.int64)
     for k, (dy, dx) in enumerate(((0, radius), (-radius, 0), (0, -radius), (radius, 0))):
-        n = g[radius + dy:radius + dy + h, radius + dx:radius + dx + w]
+        n = g[:, radius + dy:radius + dy + h, radius + dx:radius + dx + w]
         code += 3 ** k * ((n > (1 + TAU) * centre) + 2 * (n < (1 - TAU) * centre))
     return code
 
 
 def _pooled_histograms(codes: np.ndarray, n_bins: int) -> np.ndarray:
-    """(rows_of_windows, n_bins): histograms of every WINDOW x WINDOW window of a code map, max over each row."""
-    windows = sliding_window_view(codes, (WINDOW, WINDOW))[::STRIDE, ::STRIDE]   # (R, C, W, W)
-    r, c = windows.shape[:2]
-    index = (np.arange(r * c)[:, None] * n_bins + windows.reshape(r * c, -1)).ravel()
-    hist = np.bincount(index, minlength=r * c * n_bins).reshape(r, c, n_bins)
-    return hist.max(axis=1)
+    """(k, rows_of_windows * n_bins): histograms of every WINDOW x WINDOW window of code maps (k, h, w), max over
+    each row of windows."""
+    windows = sliding_window_view(codes, (WINDOW, WINDOW), axis=(1, 2))[:, ::STRIDE, ::STRIDE]   # (k, R, C, W, W)
+    k, r, c = windows.shape[:3]
+    index = (np.arange(k * r * c)[:, None] * n_bins + windows.reshape(k * r * c, -1)).ravel()
+    hist = np.bincount(index, minlength=k * r * c * n_bins).reshape(k, r, c, n_bins)
+    return hist.max(axis=2).reshape(k, -1)
 
 
-def lomo(crop: np.ndarray) -> np.ndarray:
-    """The LOMO feature of an RGB crop (any size)."""
-    img = retinex(cv2.resize(np.ascontiguousarray(crop), CROP, interpolation=cv2.INTER_AREA))
+def _each(imgs: np.ndarray, fn) -> np.ndarray:
+    return np.stack([fn(one) for one in imgs])
+
+
+def lomo(crops) -> np.ndarray:
+    """The LOMO features (k, d) of k RGB crops of any sizes, computed together: each is resized to CROP, and every
+    step after that runs on all of them at once (a crop costs a tenth of what it costs alone)."""
+    if not len(crops):
+        return np.zeros((0, _DIM), np.float32)
+    imgs = retinex(np.stack([cv2.resize(np.ascontiguousarray(c), CROP, interpolation=cv2.INTER_AREA) for c in crops]))
     colour, texture = [], []
     for _ in range(3):
-        if min(img.shape[:2]) < WINDOW:
+        if min(imgs.shape[1:3]) < WINDOW:
             break
-        hsv = cv2.cvtColor(img, cv2.COLOR_RGB2HSV).astype(np.int64)
+        hsv = _each(imgs, lambda one: cv2.cvtColor(one, cv2.COLOR_RGB2HSV)).astype(np.int64)
         bins = ((hsv[..., 0] * HSV_BINS // 180) * HSV_BINS + hsv[..., 1] * HSV_BINS // 256) * HSV_BINS \
             + hsv[..., 2] * HSV_BINS // 256
-        colour.append(_pooled_histograms(bins, HSV_BINS ** 3).ravel())
-        grey = cv2.cvtColor(img, cv2.COLOR_RGB2GRAY).astype(np.float32)
-        texture += [_pooled_histograms(_siltp(grey, r), 81).ravel() for r in (1, 2)]
-        img = cv2.resize(img, (img.shape[1] // 2, img.shape[0] // 2), interpolation=cv2.INTER_AREA)
-    parts = [np.log1p(np.concatenate(p).astype(np.float32)) for p in (colour, texture)]
-    return np.concatenate([p / max(np.linalg.norm(p), 1e-12) for p in parts])
+        colour.append(_pooled_histograms(bins, HSV_BINS ** 3))
+        grey = _each(imgs, lambda one: cv2.cvtColor(one, cv2.COLOR_RGB2GRAY)).astype(np.float32)
+        texture += [_pooled_histograms(_siltp(grey, r), 81) for r in (1, 2)]
+        imgs = _each(imgs, lambda one: cv2.resize(one, (one.shape[1] // 2, one.shape[0] // 2), interpolation=cv2.INTER_AREA))
+    parts = [np.log1p(np.concatenate(p, axis=1).astype(np.float32)) for p in (colour, texture)]
+    return np.concatenate([p / np.maximum([np.linalg.norm(row) for row in p], 1e-12)[:, None] for p in parts], axis=1)
+
+
+_ROWS = sum(((CROP[1] >> level) - WINDOW) // STRIDE + 1 for level in range(3) if min(CROP[0] >> level, CROP[1] >> level) >= WINDOW)
+_DIM = _ROWS * (HSV_BINS ** 3 + 2 * 81)  # windows' rows over the pyramid levels, times the bins of each part
 
 
 def crops(frame: np.ndarray, boxes: np.ndarray) -> list[np.ndarray]:
