@@ -66,13 +66,15 @@ def assign(cost: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray, n
     return (np.stack([rows, cols], axis=1), np.setdiff1d(np.arange(n), rows), np.setdiff1d(np.arange(m), cols))
 
 
-def _best(cost: np.ndarray) -> np.ndarray | None:
-    """The minimum-cost full row assignment of `cost` (inf = forbidden), or None if none is feasible."""
+def _best(cost: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """The minimum-cost full row assignment of `cost` (inf = forbidden) and its total, or None if none is
+    feasible."""
     try:
         rows, cols = linear_sum_assignment(cost)
     except ValueError:  # scipy: "cost matrix is infeasible"
         return None
-    return cols if np.isfinite(cost[rows, cols]).all() else None
+    total = float(cost[rows, cols].sum())
+    return (cols, total) if np.isfinite(total) else None  # an inf term (costs are never -inf or NaN) makes it inf
 
 
 def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
@@ -96,8 +98,7 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
     first = _best(cost)
     if first is None:
         return []
-    rows = np.arange(n)
-    heap = [(float(cost[rows, first].sum()), 0, first, cost)]
+    heap = [(first[1], 0, first[0], cost)]
     out, counter = [], 1
     while heap and len(out) < k:
         total, _, cols, node = heapq.heappop(heap)
@@ -112,7 +113,7 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
                 child[i, cols[i]] = np.inf
                 sol = _best(child)
                 if sol is not None:
-                    heapq.heappush(heap, (float(cost[rows, sol].sum()), counter, sol, child))
+                    heapq.heappush(heap, (sol[1], counter, sol[0], child))
                     counter += 1
             keep = forced[i, cols[i]]
             forced[i, :], forced[:, cols[i]] = np.inf, np.inf

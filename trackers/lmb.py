@@ -3,6 +3,8 @@ Murty-ranked association hypotheses, and a birth model driven by the detections 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import gaussian_mixture as gm
@@ -20,7 +22,7 @@ def factor_table(log_r: np.ndarray, log_q: np.ndarray, pd: float) -> np.ndarray:
     dead (1 - r)."""
     log_1mr = np.log1p(-np.minimum(np.exp(log_r), 1 - EPS))
     log_miss = np.log1p(-pd) if pd < 1 else -np.inf
-    return np.c_[log_r[:, None] + np.log(pd) + log_q, log_r + log_miss, log_1mr]
+    return np.column_stack([log_r[:, None] + np.log(pd) + log_q, log_r + log_miss, log_1mr])
 
 
 def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: int) -> np.ndarray:
@@ -34,9 +36,9 @@ def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: in
     and was missed; row sums are the posterior existence probabilities."""
     n, m = log_q.shape
     table = factor_table(log_r, log_q, pd)
-    options = [np.flatnonzero(np.isfinite(row)) for row in table]
-    if np.prod([float(len(o)) for o in options]) <= ENUMERATE_UP_TO:
-        choice = np.stack(np.meshgrid(*options, indexing="ij"), axis=-1).reshape(-1, n)
+    options = [np.flatnonzero(row) for row in np.isfinite(table)]
+    if math.prod(len(o) for o in options) <= ENUMERATE_UP_TO:
+        choice = cartesian_product(options)
         distinct = np.sort(np.where(choice < m, choice, m + 2 + np.arange(n)), axis=1)
         choice = choice[(np.diff(distinct, axis=1) != 0).all(axis=1)]
         log_w = table[np.arange(n), choice].sum(axis=1)
@@ -53,9 +55,21 @@ def group_update(log_r: np.ndarray, log_q: np.ndarray, pd: float, hypotheses: in
         log_w = -np.array([c for _, c in ranked])
     weights = np.exp(log_w - log_w.max())
     weights /= weights.sum()
-    beta = np.zeros((n, m + 2))
-    np.add.at(beta, (np.broadcast_to(np.arange(n), choice.shape), choice), weights[:, None])
+    cells = (np.arange(n) * (m + 2) + choice).ravel()  # each hypothesis adds its weight to its n choices
+    beta = np.bincount(cells, weights=np.repeat(weights, n), minlength=n * (m + 2)).reshape(n, m + 2)
     return beta[:, :-1]
+
+
+def cartesian_product(options: list[np.ndarray]) -> np.ndarray:
+    """(prod of lengths, len(options)): every way to pick one value from each (nonempty) array, the first varying
+    slowest (as itertools.product)."""
+    total = math.prod(len(o) for o in options)
+    out = np.empty((total, len(options)), np.intp)
+    inner = total
+    for i, o in enumerate(options):
+        inner //= len(o)
+        out[:, i] = np.tile(np.repeat(o, inner), total // (len(o) * inner))
+    return out
 
 
 class _Mixture:
