@@ -80,15 +80,20 @@ def measure(repeats: int = 5, steps: int = 200) -> list[dict]:
     return rows
 
 
+def _table(title: str, columns: list[str], rows: list[list], left: int = 0) -> str:
+    """A markdown table under a title line; the first `left` columns are aligned left, the others right."""
+    lines = [title, "| " + " | ".join(columns) + " |",
+             "|" + "|".join("---" if i < left else "---:" for i in range(len(columns))) + "|"]
+    return "\n".join(lines + ["| " + " | ".join(map(str, row)) + " |" for row in rows])
+
+
 def report(rows: list[dict]) -> str:
     """Markdown table of `measure`'s rows."""
-    out = [f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background copy and "
-           "two filled ellipses per target (frame and label map)",
-           "| targets | steps/s with frames | steps/s detections only | reference frames/s | step / reference |",
-           "|---:|---:|---:|---:|---:|"]
-    out += [f"| {r['targets']} | {r['frames_steps_per_s']:.0f} | {r['detections_steps_per_s']:.0f} | "
-            f"{r['reference_per_s']:.0f} | {r['step_over_reference']:.2f}x |" for r in rows]
-    return "\n".join(out)
+    return _table(f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background "
+                  "copy and two filled ellipses per target (frame and label map)",
+                  ["targets", "steps/s with frames", "steps/s detections only", "reference frames/s", "step / reference"],
+                  [[r["targets"], f"{r['frames_steps_per_s']:.0f}", f"{r['detections_steps_per_s']:.0f}",
+                    f"{r['reference_per_s']:.0f}", f"{r['step_over_reference']:.2f}x"] for r in rows])
 
 
 def measure_scenarios(repeats: int = 5, steps: int = 200) -> list[dict]:
@@ -106,13 +111,11 @@ def measure_scenarios(repeats: int = 5, steps: int = 200) -> list[dict]:
 
 
 def report_scenarios(rows: list[dict]) -> str:
-    out = ["env step throughput per scenario with frames and detections, medians (reference: as above, its own "
-           "targets of the first frame)",
-           "| scenario | image | targets (first frame) | steps/s | reference frames/s | step / reference |",
-           "|---|---|---:|---:|---:|---:|"]
-    out += [f"| {r['scenario']} | {r['image']} | {r['targets']} | {r['steps_per_s']:.0f} | {r['reference_per_s']:.0f} | "
-            f"{r['step_over_reference']:.2f}x |" for r in rows]
-    return "\n".join(out)
+    return _table("env step throughput per scenario with frames and detections, medians (reference: as above, its "
+                  "own targets of the first frame)",
+                  ["scenario", "image", "targets (first frame)", "steps/s", "reference frames/s", "step / reference"],
+                  [[r["scenario"], r["image"], r["targets"], f"{r['steps_per_s']:.0f}", f"{r['reference_per_s']:.0f}",
+                    f"{r['step_over_reference']:.2f}x"] for r in rows], left=2)
 
 
 STAGES = ("world", "render", "truth", "detector", "scoring", "other")
@@ -157,24 +160,22 @@ def measure_scaling(repeats: int = 5, steps: int = 100) -> list[dict]:
     return rows
 
 
-def _growth(rows: list[dict], a: dict, b: dict) -> str:
+def _growth(a: dict, b: dict) -> str:
     """Each stage's cost ratio from row a to row b."""
     return ", ".join(f"{k} {b[k] / a[k]:.1f}x" for k in (*STAGES, "total") if a[k] > 0)
 
 
 def report_scaling(rows: list[dict]) -> str:
-    out = ["env step cost by stage, milliseconds per step with frames, medians ('dense'; above 200 targets the blobs "
-           "shrink to keep the share of the image they cover)",
-           "| targets | image | steps/s | " + " | ".join(STAGES) + " |", "|---:|---|---:|" + "---:|" * len(STAGES)]
-    out += [f"| {r['targets']} | {r['image']} | {1e3 / r['total']:.0f} | " + " | ".join(f"{r[k]:.2f}" for k in STAGES)
-            + " |" for r in rows]
     by = {(r["targets"], r["image"]): r for r in rows}
     small, large = f"{SIZE[0]}x{SIZE[1]}", "1920x1080"
     pixels = by[(200, large)]["pixels"] / by[(200, small)]["pixels"]
-    out += [f"growth, 200 -> 2000 targets (10x) at {small}: " + _growth(rows, by[(200, small)], by[(2000, small)]),
-            f"growth, {small} -> {large} ({pixels:.2f}x the pixels) at 200 targets: "
-            + _growth(rows, by[(200, small)], by[(200, large)])]
-    return "\n".join(out)
+    return "\n".join([
+        _table("env step cost by stage, milliseconds per step with frames, medians ('dense'; above 200 targets the "
+               "blobs shrink to keep the share of the image they cover)", ["targets", "image", "steps/s", *STAGES],
+               [[r["targets"], r["image"], f"{1e3 / r['total']:.0f}", *(f"{r[k]:.2f}" for k in STAGES)] for r in rows]),
+        f"growth, 200 -> 2000 targets (10x) at {small}: " + _growth(by[(200, small)], by[(2000, small)]),
+        f"growth, {small} -> {large} ({pixels:.2f}x the pixels) at 200 targets: "
+        + _growth(by[(200, small)], by[(200, large)])])
 
 
 def _sequence(n: int, frames: int, seed: int = 0):
@@ -329,11 +330,10 @@ def measure_rfs(repeats: int = 5, frames: int = 100) -> list[dict]:
 
 
 def report_rfs(rows: list[dict]) -> str:
-    out = ["random-finite-set trackers on scenarios, tracker time only, medians (reference: gnn on the same detections)",
-           "| tracker | workload | ms/frame | frames/s | gnn ms/frame | tracker / gnn |", "|---|---|---:|---:|---:|---:|"]
-    out += [f"| {r['tracker']} | {r['workload']} | {r['ms']:.2f} | {1e3 / r['ms']:.0f} | {r['gnn_ms']:.2f} | "
-            f"{r['over_gnn']:.2f}x |" for r in rows]
-    return "\n".join(out)
+    return _table("random-finite-set trackers on scenarios, tracker time only, medians (reference: gnn on the same "
+                  "detections)", ["tracker", "workload", "ms/frame", "frames/s", "gnn ms/frame", "tracker / gnn"],
+                  [[r["tracker"], r["workload"], f"{r['ms']:.2f}", f"{1e3 / r['ms']:.0f}", f"{r['gnn_ms']:.2f}",
+                    f"{r['over_gnn']:.2f}x"] for r in rows], left=2)
 
 
 def _recorded(scenario: str, frames: int, config: dict | None = None,
@@ -426,7 +426,6 @@ def measure_sweeps(repeats: int = 3, config: dict | None = None) -> dict:
 
 def report_sweeps(row: dict) -> str:
     specs, scenarios, seeds = SWEEP
-    return "\n".join([f"bench grid ({', '.join(specs)} on {', '.join(scenarios)}, {seeds} seeds: {row['episodes']} "
-                      "episodes), wall time, medians",
-                      "| 1 worker | 2 workers | speed-up |", "|---:|---:|---:|",
-                      f"| {row['one_s']:.1f} s | {row['two_s']:.1f} s | {row['speedup']:.2f}x |"])
+    return _table(f"bench grid ({', '.join(specs)} on {', '.join(scenarios)}, {seeds} seeds: {row['episodes']} "
+                  "episodes), wall time, medians", ["1 worker", "2 workers", "speed-up"],
+                  [[f"{row['one_s']:.1f} s", f"{row['two_s']:.1f} s", f"{row['speedup']:.2f}x"]])
