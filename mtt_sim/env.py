@@ -163,7 +163,7 @@ class TrackingEnv(gym.Env):
             self.renderer = Renderer(sc, render_rng)
             if sc.render.camera == "follow":
                 self.renderer.camera.follow(self.world)
-            empty, _, _ = self.renderer.render(self.world, draw_frame=True, show_targets=False)
+            empty = self.renderer.render(self.world, show_targets=False)[0] if sc.sensor.model == "foreground" else None
             self.sensor = make_sensor(sc, sensor_rng, empty)
         else:
             self.sensor = SyntheticSensor(sc, sensor_rng) if sc.sensor.model == "synthetic" else None

@@ -9,6 +9,7 @@ slot + 1 where that target is visible, 0 elsewhere. Coordinates use OpenCV's fix
 from __future__ import annotations
 
 import math
+from functools import cached_property
 
 import cv2
 import numpy as np
@@ -98,15 +99,27 @@ class Renderer:
         self.shape = (r.height, r.width)
         self.camera = Camera(sc, np.random.default_rng(rng.integers(2**63)))
         self.photometric_seed = int(rng.integers(2**63))
-        self.canvas = self._background()
-        self.noise_bank = [_signed_parts(np.round(rng.normal(0, r.noise, self.shape + (3,)))) for _ in range(4)] \
-            if r.noise > 0 else []
-        self.noise_tile = rng.uniform(-45, 45, (32, 32))
         occ = sc.occluders
         self.occluder_boxes = np.array([o.rect for o in occ], float).reshape(-1, 4)
         self.occluder_depth = (self.occluder_boxes[:, 1] + self.occluder_boxes[:, 3]) if sc.world.projection == "standing" \
             else np.full(len(occ), np.inf)
         self.occluder_is_rect = np.array([o.shape == "rect" for o in occ], bool)
+
+    @cached_property
+    def _looks(self) -> tuple[np.ndarray, list, np.ndarray]:
+        """(background canvas, pixel-noise bank, texture tile), drawn from the renderer's generator, in this order,
+        the first time a frame is drawn. Nothing else draws from it after the constructor, so they are the same
+        whenever they are made, and an episode without frames (label maps only) never pays for them: at 960x540
+        they are most of a reset."""
+        r = self.sc.render
+        canvas = self._background()
+        bank = [_signed_parts(_normal(self.rng, r.noise, self.shape + (3,))) for _ in range(4)] if r.noise > 0 else []
+        return canvas, bank, self.rng.uniform(-45, 45, (32, 32))
+
+    @property
+    def canvas(self) -> np.ndarray:
+        """The static world backdrop the frames are cut from."""
+        return self._looks[0]
 
     def _background(self) -> np.ndarray:
         """The static world backdrop, with a margin for a shaking camera."""
@@ -116,8 +129,8 @@ class Renderer:
         img = np.empty((h, w, 3), np.uint8)
         img[:] = r.background_color
         if r.background in ("noise", "clutter"):
-            low = cv2.resize(self.rng.normal(0, 14, (h // 8 + 1, w // 8 + 1, 3)), (w, h), interpolation=cv2.INTER_CUBIC)
-            fine = self.rng.normal(0, 5, (h, w, 3))
+            low = cv2.resize(_normal(self.rng, 14, (h // 8 + 1, w // 8 + 1, 3)), (w, h), interpolation=cv2.INTER_CUBIC)
+            fine = _normal(self.rng, 5, (h, w, 3))
             img = np.clip(img + low + fine, 0, 255).astype(np.uint8)
         if r.background == "clutter":
             colors = np.array([g.color for g in self.sc.groups], float)
@@ -185,7 +198,7 @@ class Renderer:
         v = (np.arange(y0, y1) - box[1]) / max(box[3], 1)
         name = TEXTURES[kind]
         if name == "noise":  # the tile's 32 x 32 colours, then looked up per pixel
-            shades = np.clip(np.asarray(color) + self.noise_tile[..., None], 0, 255).astype(np.uint8)
+            shades = np.clip(np.asarray(color) + self._looks[2][..., None], 0, 255).astype(np.uint8)
             paint = shades[(v * 32).astype(int) % 32][:, (u * 32).astype(int) % 32]
         else:
             bands_v = (np.floor(v * 6) % 2).astype(bool)
@@ -201,7 +214,8 @@ class Renderer:
         Their randomness is keyed on the frame index, so drawing a frame or not never shifts other random streams.
         """
         r = self.sc.render
-        rng = np.random.default_rng((self.photometric_seed, t)) if r.flicker > 0 or self.noise_bank else None
+        bank = self._looks[1]
+        rng = np.random.default_rng((self.photometric_seed, t)) if r.flicker > 0 or bank else None
         if r.blur > 0:
             frame = cv2.GaussianBlur(frame, (0, 0), r.blur)
         gain = r.brightness * (1 + r.illumination_drift * math.sin(2 * math.pi * t / r.illumination_period))
@@ -209,13 +223,23 @@ class Renderer:
             gain *= 1 + r.flicker * rng.normal()
         if gain != 1.0:
             frame = cv2.convertScaleAbs(frame, alpha=gain)
-        if self.noise_bank:
-            up, down = self.noise_bank[rng.integers(len(self.noise_bank))]
+        if bank:
+            up, down = bank[rng.integers(len(bank))]
             frame = cv2.subtract(cv2.add(frame, up), down)
         return frame
 
 
+def _normal(rng: np.random.Generator, sigma: float, shape: tuple) -> np.ndarray:
+    """rng.normal(0, sigma, shape), the same values from the same stream, in a third of the time (a large array at
+    every reset)."""
+    out = rng.standard_normal(shape)
+    out *= sigma
+    return out
+
+
 def _signed_parts(noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Integer noise as two uint8 images, its positive and its negative part: adding one and subtracting the other,
-    each saturating, gives the frame plus the noise clipped to 0..255, five times faster than one mixed-type add."""
-    return np.clip(noise, 0, 255).astype(np.uint8), np.clip(-noise, 0, 255).astype(np.uint8)
+    """Noise rounded to integers as two uint8 images, its positive and its negative part: adding one and subtracting
+    the other, each saturating, gives the frame plus the noise clipped to 0..255, five times faster than one
+    mixed-type add."""
+    whole = np.clip(np.rint(noise, out=noise), -255, 255, out=noise).astype(np.int16)
+    return np.maximum(whole, 0).astype(np.uint8), np.maximum(-whole, 0).astype(np.uint8)

@@ -444,8 +444,9 @@ def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.
     return area, boxes, np.bincount(which, weights=weights[y, x], minlength=count - 1)
 
 
-def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray) -> Sensor:
-    """The scenario's detector; `background` (an empty frame) seeds the foreground model."""
+def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray | None) -> Sensor:
+    """The scenario's detector; `background` (an empty frame, needed by the foreground model only) seeds the
+    foreground model."""
     if sc.sensor.model == "foreground":
         return ForegroundSensor(sc, rng, background)
     return SyntheticSensor(sc, rng)

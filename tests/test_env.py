@@ -87,6 +87,20 @@ def test_same_seed_is_byte_identical_and_seeds_differ(env_id):
     assert rollout(env_id, 8, steps=5) != a[:5]
 
 
+@pytest.mark.parametrize("key", ["books", "skating"])  # textured targets, a noisy backdrop, a following camera
+def test_an_episode_without_frames_never_draws_its_looks_and_they_are_the_same_when_drawn_late(key):
+    """The backdrop, the pixel-noise bank and the texture tile are drawn on the first frame: an episode in
+    detections mode never pays for them, and drawing them late gives the pixels drawing them at once gives."""
+    early, late = TrackingEnv(key), TrackingEnv(key, obs_mode="detections")
+    early.reset(seed=3)
+    late.reset(seed=3)
+    for _ in range(5):
+        early.step(NO_TRACKS)
+        late.step(NO_TRACKS)
+    assert "_looks" not in vars(late.renderer) and "_looks" in vars(early.renderer)
+    np.testing.assert_array_equal(late.renderer.render(late.world)[0], early.frame)
+
+
 def test_detections_mode_sees_the_same_world_without_frames():
     env_f = gym.make("mtt_sim/Mot17Like-v0")
     env_d = gym.make("mtt_sim/Mot17Like-v0", obs_mode="detections")
