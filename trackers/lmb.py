@@ -68,8 +68,18 @@ def cartesian_product(options: list[np.ndarray]) -> np.ndarray:
     inner = total
     for i, o in enumerate(options):
         inner //= len(o)
-        out[:, i] = np.tile(np.repeat(o, inner), total // (len(o) * inner))
+        out[:, i].reshape(-1, len(o) * inner)[:] = np.repeat(o, inner)  # repeated down the column
     return out
+
+
+def _members(track_group: np.ndarray, meas_group: np.ndarray):
+    """(tracks, measurements) of each group numbered >= 0 in `track_group`, in increasing group order, both sorted;
+    one sort instead of two scans per group."""
+    tracks, meas = np.argsort(track_group, kind="stable"), np.argsort(meas_group, kind="stable")
+    groups = np.unique(track_group[track_group >= 0])
+    edges = np.stack([groups, groups + 1])  # each group's first and one-past-last position once sorted
+    t_bounds, m_bounds = np.searchsorted(track_group[tracks], edges), np.searchsorted(meas_group[meas], edges)
+    return [(tracks[a:b], meas[c:d]) for a, b, c, d in zip(*t_bounds.tolist(), *m_bounds.tolist())]
 
 
 class _Mixture:
@@ -296,10 +306,9 @@ class LabelledMultiBernoulli(Tracker):
         table = factor_table(log_r[alone], log_q[alone], pd)
         w = np.exp(table - table.max(axis=1, keepdims=True))
         beta[alone] = (w / w.sum(axis=1, keepdims=True))[:, :-1]
-        for g in np.unique(track_group[~alone]):
-            rows, cols = np.flatnonzero(track_group == g), np.flatnonzero(meas_group == g)
-            b = group_update(log_r[rows], log_q[np.ix_(rows, cols)], pd, p["hypotheses"])
-            beta[np.ix_(rows, cols)] = b[:, :-1]
+        for rows, cols in _members(np.where(alone, -1, track_group), meas_group):
+            b = group_update(log_r[rows], log_q[rows][:, cols], pd, p["hypotheses"])
+            beta[rows[:, None], cols] = b[:, :-1]
             beta[rows, m] = b[:, -1]
         return beta
 
