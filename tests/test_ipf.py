@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import trackers
 from helpers import run_tracker, tiny
-from mtt_sim.env import TrackingEnv
+from mtt_sim.env import NO_TRACKS, TrackingEnv
 from trackers.ipf import conflict_set
 
 
@@ -43,6 +43,52 @@ def test_conflict_set_equals_the_plain_pair_loop(seed, k, n, ratio, whole_pixels
             inter = np.prod(np.clip(hi - lo, 0, None))
             expected[a, i] |= inter > ratio * min(np.prod(sizes[a]), np.prod(sizes[b]))
     np.testing.assert_array_equal(conflict_set(centres, sizes, ratio), expected)
+
+
+class _StepWithoutNoise:
+    """A generator whose Gaussian draws are zero (the Brownian step vanishes), its other draws the real ones."""
+
+    def __init__(self, rng):
+        self.rng = rng
+
+    def normal(self, loc, scale, size):
+        return np.zeros(size)
+
+    def random(self, size):
+        return self.rng.random(size)
+
+
+@pytest.mark.parametrize("spec", ["ipf", "pcpf"])
+def test_propagation_from_the_estimate_or_from_the_resampled_particles(spec):
+    """Without the Brownian step, propagate=estimate puts every particle on the prediction; propagate=resample keeps
+    previous particles, drawn by weight (heavy ones repeated), moved as the prediction moved."""
+    env = TrackingEnv("books")
+    obs, info = env.reset(seed=0)
+    second = env.step(NO_TRACKS)[0]
+    for propagate in ("estimate", "resample"):
+        tracker = trackers.make(f"{spec}:propagate={propagate},particles=40")
+        tracker.reset(info)
+        tracker.update(obs)
+        before = tracker._cloud[0].copy()
+        prediction = tracker._predict().copy()
+        moved = prediction - tracker.estimates
+        tracker.rng = _StepWithoutNoise(tracker.rng)
+        tracker.update(second)
+        after = tracker._cloud[0]
+        if propagate == "estimate":
+            assert np.array_equal(after, np.broadcast_to(prediction[:, None], after.shape))
+        else:
+            for t in range(len(after)):
+                assert all(any(np.allclose(p, q + moved[t]) for q in before[t]) for p in after[t])
+            assert max(len(after[t]) - len(np.unique(after[t], axis=0)) for t in range(len(after))) > 0
+
+
+def test_the_step_spread_reads_delta_as_a_deviation_or_as_a_variance():
+    info = {"init_ids": np.array([1]), "init_boxes": np.array([[0.0, 0.0, 80.0, 125.0]])}
+    std, variance = trackers.make("ipf"), trackers.make("ipf:spread=variance")
+    std.reset(info)
+    variance.reset(info)
+    assert std.sigma[0] == 50.0 and variance.sigma[0] == np.sqrt(50.0)   # delta = sqrt(80 x 125) / 2 = 50
 
 
 def test_runs_and_is_reproducible_with_and_without_interaction():

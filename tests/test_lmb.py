@@ -125,6 +125,22 @@ def test_group_update_equals_enumeration_and_grouping_changes_nothing(seed):
     np.testing.assert_allclose(one, brute_force_beta(log_r[:1], log_q[:1, :2], 0.8), atol=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_group_update_through_murty_equals_brute_force_and_enumeration(seed, monkeypatch):
+    """Groups too large to enumerate go through Murty's k best: with every hypothesis kept it equals brute force; with
+    the 15 best kept it equals enumerating all and keeping the same 15."""
+    rng = np.random.default_rng(seed)
+    n, m = (4, 3) if seed < 5 else (6, 5)
+    log_r = np.log(rng.uniform(0.2, 0.95, n))
+    log_q = np.where(rng.random((n, m)) < 0.7, rng.normal(1.0, 1.5, (n, m)), -np.inf)
+    enumerated = group_update(log_r, log_q, 0.8, hypotheses=15)
+    monkeypatch.setattr("trackers.lmb.ENUMERATE_UP_TO", 0)
+    np.testing.assert_allclose(group_update(log_r, log_q, 0.8, hypotheses=15), enumerated, atol=1e-12)
+    if n == 4:
+        np.testing.assert_allclose(group_update(log_r, log_q, 0.8, hypotheses=10**4), brute_force_beta(log_r, log_q, 0.8),
+                                   atol=1e-12)
+
+
 def crossing_scene():
     walker = {"count": 1, "size": [30.0, 60.0], "size_jitter": 0.0, "speed": 2.0, "speed_jitter": 0.0,
               "heading_jitter": 0.0, "accel": 0.0}

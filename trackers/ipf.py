@@ -6,7 +6,7 @@ import numpy as np
 
 from .appearance import bhattacharyya, histograms, hs_bins
 from .base import Param, Tracker, Tracks, frame_of, register
-from .particle import crop_around, initial_targets
+from .particle import crop_around, initial_targets, systematic_resample
 from .sweep import near_in_x_and_y
 
 
@@ -64,12 +64,22 @@ class InteractiveParticleFilter(Tracker):
         "s_levels": Param(16, "[2, 256]", "saturation histogram levels"),
         "interactive": Param(True, None, "reweight conflicting particles (false: independent filters)"),
         "samples": Param(256, "[0, inf)", "pixels sampled per region for its histogram (0: all)"),
+        "propagate": Param("estimate", ("estimate", "resample"),
+                           "estimate: every particle drawn around the previous estimate (sec. 3.2: the particles "
+                           "follow a Gaussian whose mean is the target's position at t-1); resample: the previous "
+                           "particles resampled by weight, then each moved by the Brownian step (eq. 3 after sec. "
+                           "2's selection step)"),
+        "spread": Param("std", ("std", "variance"),
+                        "how to read delta = sqrt(area(R_k)) / 2 of eq. 3: as the step's standard deviation (the "
+                        "paper names eq. 6's sigma its 'variance' while writing sigma^2 = 0.045), or literally as "
+                        "its variance"),
         "seed": Param(0, "[0, inf)", "the particles' random seed")}
     needs_frame = True
 
     def reset(self, info=None):
         self.ids, self.estimates, self.sizes = initial_targets(info)
-        self.sigma = np.sqrt(np.prod(self.sizes, axis=1)) / 2
+        delta = np.sqrt(np.prod(self.sizes, axis=1)) / 2
+        self.sigma = delta if self.params["spread"] == "std" else np.sqrt(delta)
         self.rng = np.random.default_rng(self.params["seed"])
         self.templates = None
         self._cloud = (np.zeros((0, 0, 2)), np.zeros((0, 0)), np.zeros((0, 0), bool))
@@ -80,6 +90,16 @@ class InteractiveParticleFilter(Tracker):
         bins = hs_bins(crop, p["h_levels"], p["s_levels"])
         stride = max(1, int(np.sqrt(np.prod(size) / p["samples"]))) if p["samples"] else 1
         return histograms(bins, p["h_levels"] * p["s_levels"], centres - origin, tuple(size), stride=stride)
+
+    def _centres(self) -> np.ndarray:
+        """(targets, N or 1, 2): what each particle's Brownian step starts from: the prediction, or (propagate=resample,
+        after the first frame) the previous particles drawn by weight and moved as the prediction moved."""
+        prediction = self._predict()
+        previous, weights, _ = self._cloud
+        if self.params["propagate"] == "estimate" or not previous.size:
+            return prediction[:, None]
+        drawn = np.take_along_axis(previous, systematic_resample(weights, self.rng)[:, :, None], axis=1)
+        return drawn + (prediction - self.estimates)[:, None]
 
     def _predict(self) -> np.ndarray:
         """Where each target's particles are centred (eq. 3: a Brownian step from the previous estimate)."""
@@ -95,7 +115,7 @@ class InteractiveParticleFilter(Tracker):
         k, n = len(self.ids), p["particles"]
         if self.templates is None:
             self.templates = np.array([self._histograms(frame, c[None], s)[0] for c, s in zip(self.estimates, self.sizes)])
-        particles = self._predict()[:, None] + self.rng.normal(0, 1, (k, n, 2)) * self.sigma[:, None, None]
+        particles = self._centres() + self.rng.normal(0, 1, (k, n, 2)) * self.sigma[:, None, None]
         hists = [self._histograms(frame, particles[t], self.sizes[t]) for t in range(k)]
         # eq. 7's squared Bhattacharyya distance of every particle to every template, (targets, N, templates),
         # and eq. 6's Gaussian likelihood
@@ -149,6 +169,16 @@ class PathConsistencyParticleFilter(InteractiveParticleFilter):
         super().reset(info)
         self.velocity = np.zeros_like(self.estimates)
         self.occluded = np.zeros(len(self.ids), bool)
+
+    def _centres(self) -> np.ndarray:
+        """(targets, N or 1, 2): what each particle's Brownian step starts from: the prediction, or (propagate=resample,
+        after the first frame) the previous particles drawn by weight and moved as the prediction moved."""
+        prediction = self._predict()
+        previous, weights, _ = self._cloud
+        if self.params["propagate"] == "estimate" or not previous.size:
+            return prediction[:, None]
+        drawn = np.take_along_axis(previous, systematic_resample(weights, self.rng)[:, :, None], axis=1)
+        return drawn + (prediction - self.estimates)[:, None]
 
     def _predict(self) -> np.ndarray:
         return self.estimates + self.velocity
