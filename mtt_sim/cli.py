@@ -20,7 +20,8 @@ from pathlib import Path
 from . import __version__, scenario
 
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
-                "Frag", "MT", "PT", "ML", "num_frames", "num_gt_dets", "num_gt_ids")
+                "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
+                "num_gt_ids")
 INTERRUPTED = 130  # the shell's status for a command stopped by Ctrl-C (SIGTERM is treated the same way)
 
 
@@ -251,8 +252,7 @@ def cmd_run(args) -> int:
         if args.json:
             print(json.dumps(summary))
             continue
-        for k, v in summary.items():
-            print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
+        _print_summary(summary)
     if args.json:
         return 0
     for name, path in (("video", video), ("results", results)):
@@ -262,10 +262,12 @@ def cmd_run(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    from .metrics import PER_TARGET
+
     overrides = _overrides(args)
     _loaded(args.scenarios, overrides)
-    if args.by == "target" and set(args.metric) - {"CentreError", "Coverage"}:
-        raise UsageError("--metric", "with --by target: CentreError or Coverage (per-target metrics)")
+    if args.by == "target" and set(args.metric) - set(PER_TARGET):
+        raise UsageError("--metric", f"with --by target: {', '.join(PER_TARGET)} (per-target metrics)")
     title = ",".join(args.scenarios) if args.by == "target" else ""
     _plot_output(args)
     if args.plot and args.by == "target":
@@ -486,9 +488,14 @@ def cmd_eval(args) -> int:
     if args.json:
         print(json.dumps(summary))
         return 0
-    for k, v in summary.items():
-        print(f"{k:12s} {v:.3f}" if isinstance(v, float) else f"{k:12s} {v}")
+    _print_summary(summary)
     return 0
+
+
+def _print_summary(summary: dict) -> None:
+    """One metric a line: floats to 3 decimals, "-" for a measure with no value (no occlusion decided, say)."""
+    for k, v in summary.items():
+        print(f"{k:17s} {v:.3f}" if isinstance(v, float) else f"{k:17s} {'-' if v is None else v}")
 
 
 def cmd_check_real(args) -> int:
@@ -585,8 +592,8 @@ def build_parser() -> argparse.ArgumentParser:
         if name == "bench":
             g.add_argument("--scenarios", type=_scenarios, required=True, help="comma-separated scenarios")
             g.add_argument("--by", choices=("scenario", "target"), default="scenario",
-                           help="columns: scenarios, or ground-truth ids for the per-target metrics CentreError and "
-                                "Coverage (hand-initialised trackers; one scenario)")
+                           help="columns: scenarios, or ground-truth ids for the per-target metrics (CentreError, "
+                                "Coverage, HiddenCentreError, Reacquired; hand-initialised trackers; one scenario)")
         else:
             g.add_argument("scenario", type=_scenario, help=scenario_help)
             g.add_argument("--param", required=True, metavar="KEY=V1,V2,...", help="e.g. sensor.clutter_rate=0,2,5,10,20")

@@ -205,12 +205,14 @@ class TrackingEnv(gym.Env):
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self.remember_tracks(ids, boxes)
+        everyone = None
         if self.recording is None:
-            scored = self.truth.visibility >= self.scenario.scoring.min_visibility
-            gt_ids, gt_boxes, kept = self.truth.ids[scored], self.truth.boxes[scored], slice(None)
+            t = self.truth
+            scored = t.visibility >= self.scenario.scoring.min_visibility
+            gt_ids, gt_boxes, kept, everyone = t.ids[scored], t.boxes[scored], slice(None), (t.ids, t.boxes, t.visibility)
         else:
             gt_ids, gt_boxes, kept = self.recording.scoring(self.steps, boxes)
-        stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept])
+        stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept], everyone)
         reward = self._reward(stats) if self.recording is None or self.recording.scored else 0.0
         if self.recording is None:
             self.world.step()

@@ -223,7 +223,7 @@ def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float]
 
 def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario") -> list[dict]:
     """One row per (tracker, `by`) cell: the metric's mean and 95 % interval over the seeds that ran, how many failed,
-    and the speeds. `by` is "scenario", "config" (sweeps) or "target" (a per-target metric, CentreError or Coverage,
+    and the speeds. `by` is "scenario", "config" (sweeps) or "target" (a per-target metric, one of PER_TARGET,
     per GT id)."""
     names = PER_TARGET if by == "target" else METRICS
     if metric not in names:
@@ -248,6 +248,7 @@ def summarize(records: Sequence[dict], metric: str = "MOTA", by: str = "scenario
         values = np.array([v for v, _ in ran], float)
         mean, ci = mean_ci(values[np.isfinite(values)])
         rows.append({"tracker": tracker, "column": column, "metric": metric, "mean": mean, "ci95": ci, "n": len(ran),
+                     "valued": int(np.isfinite(values).sum()),  # episodes with a value (an occlusion window may have none)
                      "failed": len(cell) - len(ran), "integer": all(isinstance(v, int) for v, _ in ran),
                      "tracker_fps": float(np.median([r["tracker_fps"] for _, r in ran])) if ran else math.nan,
                      "env_fps": float(np.median([r["env_fps"] for _, r in ran])) if ran else math.nan})
@@ -284,9 +285,12 @@ def _cell_text(row: dict | None) -> str:
     if not row["n"]:
         return "failed"
     failed = f" ({row['failed']} of {row['n'] + row['failed']} failed)" if row["failed"] else ""
+    if not row["valued"]:  # nothing to measure in any episode (no occlusion decided, say)
+        return "-" + failed
     digits = 0 if row["integer"] and row["n"] == 1 else 1 if row["integer"] else 3
-    value = f"{row['mean']:.{digits}f}" + (f" ± {row['ci95']:.{digits}f}" if row["n"] > 1 else "")
-    return value + failed
+    value = f"{row['mean']:.{digits}f}" + (f" ± {row['ci95']:.{digits}f}" if row["valued"] > 1 else "")
+    valued = f" ({row['valued']} of {row['n']} with a value)" if row["valued"] < row["n"] else ""
+    return value + valued + failed
 
 
 def write_records(records: Sequence[dict], path: str | Path) -> None:

@@ -29,6 +29,18 @@ Semantics, following TrackEval where other tools differ:
   matches, pooled over targets (the error measure of the JPDA paper's Tables 3 and 4), in pixels.
 - Similarity "iou" is the box IoU; "centroid" is TrackEval's point similarity
   max(0, 1 - d / zero_distance) on box centres.
+- Occlusion windows (scenes whose truth is passed to `update` as `everyone`; nan, 0 otherwise). A target is
+  *hidden* in a frame where its visibility is below HIDDEN (0.05); its *holder* is the track CLEAR-matched to it
+  in the latest frame it was matched (none before its first match).
+  HiddenCentreError: the mean distance in pixels between a hidden target's box centre and its holder's reported
+  box centre, over the hidden frames in which the holder is reported.
+  An *occlusion* begins at a hidden frame of a target that has a holder and no occlusion under way; it is
+  *revealed* at the first later frame where the target is at least REVEALED (0.5) visible, and *re-acquired* if
+  its holder at the beginning is CLEAR-matched to the target in one of the WINDOW (20) frames from that one on.
+  An occlusion is decided when its window has passed. Reacquired: the share re-acquired among those decided;
+  Occlusions: how many were decided. One whose window the episode cuts short is not counted, re-acquired or not,
+  so that where an episode ends favours no tracker. HiddenCentreError and Reacquired are None where nothing was
+  counted.
 """
 
 from __future__ import annotations
@@ -40,6 +52,8 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 EPS = np.finfo(float).eps
+HIDDEN, REVEALED, WINDOW = 0.05, 0.5, 20  # the occlusion windows' visibilities and frames (module docstring)
+_CLEAR, _HIDDEN, _WINDOW = 0, 1, 2  # a target's occlusion: none under way, hidden and not yet revealed, in its window
 HOTA_ALPHAS = np.arange(0.05, 0.99, 0.05)
 SIMILARITIES = ("iou", "centroid")
 
@@ -224,6 +238,72 @@ class _Episode:
         return starts[frame, 0] + self.match_row.data, starts[frame, 1] + self.match_col.data
 
 
+class _OcclusionWindows:
+    """The occlusion-window measures (module docstring), kept per target id in growing arrays."""
+
+    def __init__(self):
+        self.ids = _IdIndex()
+        self.holder = _Grow(-1, np.int64)      # tracker id of the latest match
+        self.stage = _Grow(_CLEAR, np.int8)    # where each target's occlusion stands
+        self.owed = _Grow(-1, np.int64)        # the holder an occlusion under way waits for
+        self.deadline = _Grow(-1, np.int64)    # the last frame of its window
+        self.won = _Grow(False, bool)          # whether the holder has matched the target in the window so far
+        self.error = _Grow(0.0, float, 2)      # summed hidden centre error, frames counted
+        self.decided = _Grow(0, np.int64, 2)   # occlusions re-acquired, occlusions decided
+        self.frame = -1
+
+    def update(self, ids, boxes, visibility, trk_ids, trk_boxes, matched_gt, matched_trk) -> None:
+        """One frame: every target in view (ids, boxes, visibility), the reported tracks, the CLEAR matches."""
+        self.frame += 1
+        g = self.ids(np.asarray(ids, np.int64))
+        n = len(self.ids)
+        holder, stage, owed, deadline, won = (a.ensure(n) for a in (self.holder, self.stage, self.owed, self.deadline,
+                                                                     self.won))
+        error, decided = self.error.ensure(n), self.decided.ensure(n)
+        visibility = np.asarray(visibility, float)
+        matched_to = np.full(n, -1, np.int64)
+        matched_to[self.ids(np.asarray(matched_gt, np.int64))] = matched_trk
+        revealed = g[(stage[g] == _HIDDEN) & (visibility >= REVEALED)]
+        stage[revealed], deadline[revealed] = _WINDOW, self.frame + WINDOW - 1
+        waiting = np.flatnonzero(stage[:n] == _WINDOW)
+        won[waiting] |= matched_to[waiting] == owed[waiting]
+        over = waiting[deadline[waiting] <= self.frame]  # decided when the window has passed, won or not
+        decided[over, 0] += won[over]
+        decided[over, 1] += 1
+        stage[over], won[over] = _CLEAR, False
+        hidden = g[visibility < HIDDEN]
+        held = hidden[holder[hidden] >= 0]
+        starting = held[stage[held] == _CLEAR]
+        stage[starting], owed[starting] = _HIDDEN, holder[starting]
+        row_of = {i: r for r, i in enumerate(np.asarray(trk_ids).tolist())}
+        row = np.array([row_of.get(h, -1) for h in holder[held].tolist()], np.intp)
+        seen = row >= 0
+        if seen.any():
+            where = np.flatnonzero(np.isin(g, held[seen]))  # the same order as held[seen]: both follow g
+            d = np.linalg.norm(centres(np.asarray(boxes)[where]) - centres(np.asarray(trk_boxes)[row[seen]]), axis=1)
+            error[held[seen], 0] += d
+            error[held[seen], 1] += 1
+        now = np.flatnonzero(matched_to >= 0)
+        holder[now] = matched_to[now]
+
+    def summary(self) -> dict:
+        n = len(self.ids)
+        error, decided = self.error.ensure(n)[:n].sum(axis=0), self.decided.ensure(n)[:n].sum(axis=0)
+        return {"HiddenCentreError": _ratio(error[0], error[1]), "Reacquired": _ratio(decided[0], decided[1]),
+                "Occlusions": int(decided[1])}
+
+    def per_target(self) -> dict[int, dict]:
+        n = len(self.ids)
+        error, decided = self.error.ensure(n), self.decided.ensure(n)
+        return {i: {"HiddenCentreError": _ratio(error[k, 0], error[k, 1]),
+                    "Reacquired": _ratio(decided[k, 0], decided[k, 1])} for i, k in self.ids.index.items()}
+
+
+def _ratio(a: float, b: float) -> float | None:
+    """a / b, or None (no value: nothing was counted) when b is 0."""
+    return float(a / b) if b else None
+
+
 class EpisodeMetrics:
     """Incremental MOT metrics for one sequence: `update` every frame, `summary` at the end."""
 
@@ -248,6 +328,8 @@ class EpisodeMetrics:
         self.tp = self.fp = self.fn = self.idsw = 0
         self.similarity_total = 0.0
         self._episode = _Episode()  # what the global passes need of every frame
+        self._occlusion = _OcclusionWindows()
+        self._pairs = (_NONE, _NONE)  # the latest frame's CLEAR matches: rows of its GT, columns of its tracks
 
     # ------------------------------------------------------------ per frame
 
@@ -258,8 +340,17 @@ class EpisodeMetrics:
             return box_iou(gt_boxes, trk_boxes)
         return np.maximum(0.0, 1.0 - centre_distance(gt_boxes, trk_boxes) / self.zero_distance)
 
-    def update(self, gt_ids, gt_boxes, trk_ids, trk_boxes) -> FrameStats:
-        """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h."""
+    def update(self, gt_ids, gt_boxes, trk_ids, trk_boxes, everyone=None) -> FrameStats:
+        """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h. `everyone`:
+        (ids, boxes, visibility) of every target in view, hidden ones too, for the occlusion windows."""
+        stats = self._score(gt_ids, gt_boxes, trk_ids, trk_boxes)
+        if everyone is not None:
+            rows, cols = self._pairs
+            self._occlusion.update(*everyone, trk_ids, trk_boxes, np.asarray(gt_ids)[rows], np.asarray(trk_ids)[cols])
+        return stats
+
+    def _score(self, gt_ids, gt_boxes, trk_ids, trk_boxes) -> FrameStats:
+        self._pairs = (_NONE, _NONE)
         gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, len(self._episode))
         trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, len(self._episode))
         g, t = self._gt_ids(gt_ids), self._trk_ids(trk_ids)
@@ -295,6 +386,7 @@ class EpisodeMetrics:
         prev[mg] = mt
         self._prev_rows = mg
         self._episode.add_matches(rows, cols)
+        self._pairs = (rows, cols)
         tp, s = len(mg), float(sim[rows, cols].sum())
         fn, fp = len(g) - tp, len(t) - tp
         self.tp, self.fp, self.fn, self.idsw = self.tp + tp, self.fp + fp, self.fn + fn, self.idsw + idsw
@@ -340,9 +432,11 @@ class EpisodeMetrics:
         out.update(self._identity(flat))
         out.update(_hota(flat))
         out["GOSPA"] = self._mean_gospa()
+        out.update(self._occlusion.summary())
         out.update(num_frames=len(self._episode), num_gt_dets=flat.num_gt_dets, num_gt_ids=num_gt_ids,
                    num_tracker_dets=flat.num_trk_dets, num_tracker_ids=num_trk_ids)
-        return {k: (float(v) if isinstance(v, (float, np.floating)) else int(v)) for k, v in out.items()}
+        return {k: (float(v) if isinstance(v, (float, np.floating)) else v if v is None else int(v))
+                for k, v in out.items()}
 
     def _mean_gospa(self) -> float:
         """The mean over frames of each frame's GOSPA."""
@@ -359,14 +453,17 @@ class EpisodeMetrics:
 
     def per_target(self) -> dict[int, dict]:
         """Per GT id: Coverage (the fraction of its frames with a CLEAR match) and CentreError (the mean centre
-        distance of those matches, nan if none): the per-target tracking error the papers plot."""
+        distance of those matches, nan if none): the per-target tracking error the papers plot; and its
+        HiddenCentreError and Reacquired (module docstring)."""
         n = len(self._gt_ids)
         gt, dist = self._match_distances()
         total = np.bincount(gt, dist, minlength=n)
         matched, seen = self._matched.ensure(n)[:n], self._seen.ensure(n)[:n]
         with np.errstate(invalid="ignore", divide="ignore"):
             error, coverage = total / matched, matched / np.maximum(seen, 1)
-        return {int(i): {"Coverage": float(coverage[k]), "CentreError": float(error[k])}
+        hidden = self._occlusion.per_target()
+        nothing = {"HiddenCentreError": None, "Reacquired": None}
+        return {int(i): {"Coverage": float(coverage[k]), "CentreError": float(error[k]), **hidden.get(i, nothing)}
                 for i, k in self._gt_ids.index.items()}
 
     def _identity(self, flat: "_Flat") -> dict:
@@ -500,4 +597,4 @@ def evaluate(gt: Sequence[tuple], tracks: Sequence[tuple], similarity: str = "io
 
 
 METRICS = tuple(EpisodeMetrics().summary())  # every metric of an episode summary, in summary order
-PER_TARGET = ("CentreError", "Coverage")  # the metrics of EpisodeMetrics.per_target()
+PER_TARGET = ("CentreError", "Coverage", "HiddenCentreError", "Reacquired")  # EpisodeMetrics.per_target()'s

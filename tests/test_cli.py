@@ -118,7 +118,7 @@ BAD_ARGUMENTS = [
     (["bench", "--scenarios", "crossing", "--trackers", "sort", "--workers", "0"], r"argument --workers: must be"),
     (["bench", "--scenarios", "crossing", "--trackers", "sort", "--out", "r.txt"], r"must end in \.csv or \.json"),
     (["bench", "--scenarios", "crossing", "--trackers", "sort", "--by", "target"],
-     r"argument --metric: with --by target: CentreError or Coverage"),
+     r"argument --metric: with --by target: CentreError, Coverage, HiddenCentreError, Reacquired"),
     (["sweep", "crossing", "--param", "sensor.pd=0.5,2", "--trackers", "sort"], r"argument --param: .*sensor\.pd = 2"),
     (["sweep", "crossing", "--param", "sensor.pd", "--trackers", "sort"], r"argument --param: 'sensor.pd': expected key="),
     (["learn-reid", "--every", "0"], r"argument --every: must be an integer >= 1, got '0'"),

@@ -107,7 +107,7 @@ def test_external_adapter_runs_a_third_party_tracker_in_the_gym_loop():
     _, _, theirs = in_process(trackers.External(factory=SortReferenceStyle, box_format="xyxy"))
     assert theirs.keys() == ours.keys()
     for key, value in ours.items():   # counts exactly; float32 boxes through x1, y1, x2, y2 and back: rounding only
-        assert theirs[key] == (value if isinstance(value, int) else pytest.approx(value, rel=1e-6)), key
+        assert theirs[key] == (pytest.approx(value, rel=1e-6) if isinstance(value, float) else value), key
     with pytest.raises(ValueError, match="box_format='tlbr': allowed values: 'xywh', 'xyxy'"):
         trackers.External(SortReferenceStyle(), box_format="tlbr")
     with pytest.raises(TypeError, match="has no update"):
@@ -140,7 +140,7 @@ def test_a_supervision_tracker_runs_in_the_gym_loop():
     _, _, theirs = in_process(trackers.SupervisionTracker(factory=SupervisionStyle,
                                                           detections_type=StandInDetections))
     for key, value in ours.items():
-        assert theirs[key] == (value if isinstance(value, int) else pytest.approx(value, rel=1e-6)), key
+        assert theirs[key] == (pytest.approx(value, rel=1e-6) if isinstance(value, float) else value), key
     with pytest.raises(TypeError, match="has no update_with_detections"):
         trackers.SupervisionTracker(object(), detections_type=StandInDetections).reset({})
     lost = trackers.SupervisionTracker(SimpleNamespace(update_with_detections=lambda d: "nothing"),

@@ -72,7 +72,8 @@ def test_per_target_centre_error_and_coverage():
         m.update(*frame(A, B), *frame(*tracks))
     m.update(*frame((3, 50, 50, 10, 10)), *E)  # target 3: never matched
     per = m.per_target()
-    assert per[1] == {"Coverage": 1.0, "CentreError": 1.0} and per[2] == {"Coverage": 0.5, "CentreError": 3.0}
+    none = {"HiddenCentreError": None, "Reacquired": None}   # no truth of hidden targets was passed
+    assert per[1] == {"Coverage": 1.0, "CentreError": 1.0, **none} and per[2] == {"Coverage": 0.5, "CentreError": 3.0, **none}
     assert per[3]["Coverage"] == 0.0 and math.isnan(per[3]["CentreError"])
     assert m.summary()["CentreError"] == pytest.approx((4 * 1 + 2 * 3) / 6)
 
@@ -239,3 +240,40 @@ def test_a_long_episode_keeps_little_per_frame():
     peak = tracemalloc.get_traced_memory()[1] - before
     tracemalloc.stop()
     assert stored / 300 < 20 * 1024 and peak < 4 * stored, (stored / 300, peak / stored)
+
+
+def occlusion_episode(visibility, reported, shift=(3.0, 4.0), frames_after=0):
+    """One target (id 1) at a fixed box; visibility per frame; `reported[k]` the id of the track reported on it in
+    frame k (None: no track). A track's box is the target's while it is at least half visible (so it is matched),
+    shifted by `shift` while it is hidden (unmatched: the estimate carried through)."""
+    m = EpisodeMetrics()
+    box = np.array([[100.0, 100.0, 20.0, 40.0]])
+    for v, t in zip(visibility + [1.0] * frames_after, reported + [None] * frames_after):
+        trk_ids = np.array([] if t is None else [t])
+        trk_boxes = np.zeros((0, 4)) if t is None else box + ([*shift, 0, 0] if v < 0.05 else 0)
+        scored = v >= 0.05
+        m.update(np.array([1] if scored else []), box if scored else np.zeros((0, 4)), trk_ids, trk_boxes,
+                 everyone=(np.array([1]), box, np.array([v])))
+    return m.summary(), m.per_target()
+
+
+def test_occlusion_windows_on_hand_made_sequences():
+    hidden = [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.3, 1.0]        # held by track 7, hidden 4 frames, revealed in frame 7
+    s, per = occlusion_episode(hidden, [7, 7, 7, 7, None, 7, 7, 7], frames_after=19)   # its window: frames 7-26
+    assert s["HiddenCentreError"] == 5.0 and s["Reacquired"] == 1.0 and s["Occlusions"] == 1   # 3 hidden frames held
+    assert per[1]["HiddenCentreError"] == 5.0 and per[1]["Reacquired"] == 1.0
+    s, _ = occlusion_episode(hidden, [7, 7, 7, 7, None, 7, 7, 7], frames_after=18)   # the episode cuts the window
+    assert s["Occlusions"] == 0 and s["Reacquired"] is None and s["HiddenCentreError"] == 5.0
+    s, _ = occlusion_episode(hidden, [7, 7, 7, 7, 7, 7, 9, 9], frames_after=25)    # another track takes it back
+    assert s["Reacquired"] == 0.0 and s["Occlusions"] == 1
+    s, _ = occlusion_episode(hidden[:6] + [1.0] * 30, [7] * 6 + [9] * 10 + [7] * 20)  # track 7 back 10 frames later
+    assert s["Reacquired"] == 1.0
+    s, _ = occlusion_episode(hidden[:6] + [1.0] * 30, [7] * 6 + [9] * 20 + [7] * 10)  # 20 frames later: too late
+    assert s["Reacquired"] == 0.0 and s["Occlusions"] == 1
+    s, _ = occlusion_episode([0.0, 0.0, 1.0, 1.0], [None, None, 7, 7], frames_after=30)  # hidden before any match
+    assert s["Occlusions"] == 0 and s["HiddenCentreError"] is None
+    s, _ = occlusion_episode([1.0] + [0.0] * 30, [7] + [None] * 30)                 # never revealed: not decided
+    assert s["Occlusions"] == 0 and s["HiddenCentreError"] is None             # and the holder reported nothing
+    plain = EpisodeMetrics()
+    plain.update([1], [[0, 0, 10, 10]], [1], [[0, 0, 10, 10]])
+    assert plain.summary()["Occlusions"] == 0 and plain.summary()["Reacquired"] is None
