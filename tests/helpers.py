@@ -37,13 +37,16 @@ def placed(sc: scenario.Scenario, positions, seed=0) -> TrackingEnv:
 
 
 def run_tracker(spec, env_id, config=None, seed=0, obs_mode="detections"):
-    """One episode of tracker `spec` on `env_id` through gym.make: (the episode's metrics, the tracker)."""
+    """One episode of tracker `spec` on `env_id` through gym.make (or on a scenario: a Scenario or a .toml path, in a
+    TrackingEnv): (the episode's metrics, the tracker)."""
     import gymnasium as gym
 
     import mtt_sim  # noqa: F401  (registers the env ids)
     import trackers
 
-    env = gym.make(env_id, obs_mode=obs_mode, config=config or {})
+    registered = isinstance(env_id, str) and env_id.startswith("mtt_sim/")
+    env = gym.make(env_id, obs_mode=obs_mode, config=config or {}) if registered else \
+        TrackingEnv(env_id, config or {}, obs_mode=obs_mode)
     obs, info = env.reset(seed=seed)
     tracker = trackers.make(spec)
     tracker.reset(info)

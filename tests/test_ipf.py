@@ -150,18 +150,8 @@ def test_path_consistency_baseline_coasts_through_a_static_occluder():
 
 def test_occlusion_windows_see_the_interactive_filter_take_a_hidden_book_back_and_independent_filters_not():
     sc = str(EXPERIMENTS / "lookalike_crossing.toml")
-    measured = {}
-    for spec in ("ipf", "ipf:interactive=false"):
-        env = TrackingEnv(sc, {"env.max_steps": 90}, obs_mode="frame+detections")  # room for the 20-frame window
-        obs, info = env.reset(seed=0)
-        tracker = trackers.make(spec)
-        tracker.reset(info)
-        while True:
-            obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
-            if term or trunc:
-                break
-        measured[spec] = info["metrics"]
-    kept, lost = measured["ipf"], measured["ipf:interactive=false"]
+    kept, lost = (run_tracker(spec, sc, {"env.max_steps": 90}, obs_mode="frame+detections")[0]  # room for the window
+                  for spec in ("ipf", "ipf:interactive=false"))
     assert kept["Occlusions"] == lost["Occlusions"] == 1
     assert kept["Reacquired"] == 1.0 and lost["Reacquired"] == 0.0
     assert kept["HiddenCentreError"] < lost["HiddenCentreError"]

@@ -152,15 +152,7 @@ def crossing_scene():
 
 @pytest.mark.parametrize("spec", ["lmb:reid=false", "gmphd"])
 def test_labels_survive_a_crossing(spec):
-    env = TrackingEnv(crossing_scene())
-    obs, info = env.reset(seed=0)
-    tracker = trackers.make(spec)
-    tracker.reset(info)
-    while True:
-        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
-        if term or trunc:
-            break
-    m = info["metrics"]
+    m, _ = run_tracker(spec, crossing_scene())
     assert m["IDSW"] == 0 and m["num_tracker_ids"] == 2 and m["MOTA"] > 0.9
 
 

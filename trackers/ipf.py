@@ -170,16 +170,6 @@ class PathConsistencyParticleFilter(InteractiveParticleFilter):
         self.velocity = np.zeros_like(self.estimates)
         self.occluded = np.zeros(len(self.ids), bool)
 
-    def _centres(self) -> np.ndarray:
-        """(targets, N or 1, 2): what each particle's Brownian step starts from: the prediction, or (propagate=resample,
-        after the first frame) the previous particles drawn by weight and moved as the prediction moved."""
-        prediction = self._predict()
-        previous, weights, _ = self._cloud
-        if self.params["propagate"] == "estimate" or not previous.size:
-            return prediction[:, None]
-        drawn = np.take_along_axis(previous, systematic_resample(weights, self.rng)[:, :, None], axis=1)
-        return drawn + (prediction - self.estimates)[:, None]
-
     def _predict(self) -> np.ndarray:
         return self.estimates + self.velocity
 
