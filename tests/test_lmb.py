@@ -90,6 +90,20 @@ def test_existence_rises_with_detections_at_the_rate_of_the_formula_and_a_birth_
     assert len(lmb.pending[0]) == 0    # an explained detection gives no birth
 
 
+@pytest.mark.parametrize("rule, expected", [("confidence", [0.3, 0.6]), ("reuter", [0.5, 0.5]),
+                                             ("reuter_confidence", [0.25, 0.5])])
+def test_birth_rules_give_their_formulas_existence(rule, expected):
+    """Two unexplained detections (confidences 0.5 and 1): ours, birth_max x confidence; Reuter et al.'s eq. 75,
+    min(birth_max, lambda_B (1 - r_U) / sum (1 - r_U)) with lambda_B = 1; and that times the confidence."""
+    lmb = trackers.make("lmb", reid=False, birth_rule=rule, birth_rate=1.0, birth_max=0.6)
+    lmb.reset(INFO)
+    lmb.update(obs_of())
+    lmb.update(obs_of([100, 100, 30, 60, 0.5], [300, 200, 30, 60, 1.0]))
+    np.testing.assert_allclose(lmb.pending[1], expected)
+    np.testing.assert_allclose(lmb._birth_existence(np.array([1.0, 0.5, 0.0]), np.ones(3)),
+                               {"confidence": [0.6, 0.3, 0.0]}.get(rule, [0.6, 1 / 3, 0.0]))
+
+
 def brute_force_beta(log_r, log_q, pd):
     """Every joint hypothesis of a group enumerated: each track takes a distinct measurement, is missed or is dead."""
     n, m = log_q.shape

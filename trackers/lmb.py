@@ -149,6 +149,12 @@ class LabelledMultiBernoulli(Tracker):
         "hypotheses": Param(15, "[1, inf)", "best association hypotheses per group (Murty)"),
         "birth": Param("adaptive", ("adaptive", "fixed"), "adaptive: births from unexplained detections by "
                                                           "confidence (the paper); fixed: along the borders"),
+        "birth_rule": Param("confidence", ("confidence", "reuter", "reuter_confidence"),
+                            "adaptive birth's r_B: confidence: birth_max x confidence x (1 - r_U) (ours); reuter: "
+                            "min(birth_max, birth_rate (1 - r_U) / sum of (1 - r_U)) (Reuter et al. 2014, eq. 75); "
+                            "reuter_confidence: that times the confidence. r_U: the probability the detection was "
+                            "associated"),
+        "birth_rate": Param(1.0, "(0, inf)", "lambda_B of birth_rule=reuter: expected newborn targets a frame"),
         "birth_max": Param(0.6, "(0, 1)", "largest newborn existence probability (a fully confident, unexplained "
                                           "detection)"),
         "fixed_births": Param(16, "[1, inf)", "newborn components a frame with birth=fixed"),
@@ -209,6 +215,14 @@ class LabelledMultiBernoulli(Tracker):
             m, P = self.noise.birth(boxes)
         t.add(r, self._labels(len(r)), m, P)
 
+    def _birth_existence(self, unexplained: np.ndarray, conf: np.ndarray) -> np.ndarray:
+        """r_B of the newborn track each detection gives, from 1 - r_U (how unexplained it is) and its confidence."""
+        p = self.params
+        if p["birth_rule"] == "confidence":
+            return p["birth_max"] * conf * unexplained
+        share = np.minimum(p["birth_max"], p["birth_rate"] * unexplained / max(unexplained.sum(), EPS))
+        return share * conf if p["birth_rule"] == "reuter_confidence" else share
+
     def _fixed_birth_boxes(self, dets: np.ndarray) -> np.ndarray:
         """`fixed_births` boxes spread evenly around the image border, sized like this frame's median detection."""
         w, h = self.image_size
@@ -259,7 +273,7 @@ class LabelledMultiBernoulli(Tracker):
         t.replace(r_new, track, weights, means, covs, keep, p["max_components"], p["prune"])
 
         associated = beta[:, :n_meas].sum(axis=0) if n_tracks else np.zeros(n_meas)
-        r_birth = p["birth_max"] * conf * np.clip(1 - associated, 0, 1)
+        r_birth = self._birth_existence(np.clip(1 - associated, 0, 1), conf)
         fresh = r_birth > p["prune"]
         self.pending = (z[fresh], r_birth[fresh])
         report = t.r > p["extract"]
