@@ -343,6 +343,8 @@ class EpisodeMetrics:
     def update(self, gt_ids, gt_boxes, trk_ids, trk_boxes, everyone=None) -> FrameStats:
         """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h. `everyone`:
         (ids, boxes, visibility) of every target in view, hidden ones too, for the occlusion windows."""
+        if everyone is not None:
+            everyone = _check_everyone(everyone, gt_ids, len(self._episode))
         stats = self._score(gt_ids, gt_boxes, trk_ids, trk_boxes)
         if everyone is not None:
             rows, cols = self._pairs
@@ -582,6 +584,24 @@ def _check_frame(what: str, ids, boxes, frame: int) -> tuple[np.ndarray, np.ndar
     if len(set(ids.tolist())) != len(ids):
         raise ValueError(f"frame {frame}: {what} ids must be unique within a frame")
     return ids.astype(np.int64), boxes
+
+
+def _check_everyone(everyone, gt_ids, frame: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validated (ids, boxes, visibility) of every target in view, or a ValueError naming the problem."""
+    try:
+        ids, boxes, visibility = everyone
+    except (TypeError, ValueError):
+        raise ValueError(f"frame {frame}: everyone must be (ids, boxes, visibility) of every target in view") from None
+    ids, boxes = _check_frame("everyone", ids, boxes, frame)
+    visibility = np.asarray(visibility, float)
+    if visibility.shape != ids.shape or not np.isfinite(visibility).all():
+        raise ValueError(f"frame {frame}: everyone's visibility must be {ids.shape} finite numbers, got shape "
+                         f"{visibility.shape}")
+    missing = set(np.asarray(gt_ids).tolist()) - set(ids.tolist())
+    if missing:
+        raise ValueError(f"frame {frame}: everyone must include every scored ground-truth id; missing "
+                         f"{sorted(missing)}")
+    return ids, boxes, visibility
 
 
 def evaluate(gt: Sequence[tuple], tracks: Sequence[tuple], similarity: str = "iou", threshold: float = 0.5,

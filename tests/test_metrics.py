@@ -277,3 +277,15 @@ def test_occlusion_windows_on_hand_made_sequences():
     plain = EpisodeMetrics()
     plain.update([1], [[0, 0, 10, 10]], [1], [[0, 0, 10, 10]])
     assert plain.summary()["Occlusions"] == 0 and plain.summary()["Reacquired"] is None
+
+
+def test_occlusion_windows_need_every_scored_target_among_those_in_view():
+    m = EpisodeMetrics()
+    box = np.array([[0.0, 0.0, 10.0, 10.0]])
+    with pytest.raises(ValueError, match=r"frame 0: everyone must include every scored ground-truth id; missing \[1\]"):
+        m.update([1], box, [5], box, everyone=(np.array([2]), box, np.array([1.0])))
+    with pytest.raises(ValueError, match=r"frame 0: everyone's visibility must be \(1,\) finite numbers"):
+        m.update([1], box, [5], box, everyone=(np.array([1]), box, np.array([np.nan])))
+    with pytest.raises(ValueError, match=r"frame 0: everyone must be \(ids, boxes, visibility\)"):
+        m.update([1], box, [5], box, everyone=(np.array([1]), box))
+    assert len(m) == 0 and m.summary()["TP"] == 0   # a rejected frame is not scored
