@@ -23,6 +23,7 @@ import pymunk.batch as pbatch
 from .scenario import MOTIONS, TEXTURES, Scenario
 
 WALL_BIT = 1 << 31
+_FREE, _FOR_GOOD, _LEFT = 0, -1, -2  # carry_left beside the frames left to ride: free, a carried group's, just left
 _FIELDS = pbatch.BodyFields.BODY_ID | pbatch.BodyFields.POSITION | pbatch.BodyFields.VELOCITY
 _WALL = 200.0  # wall thickness, px
 _EXIT_MIN_AGE = 10  # frames a target must have lived before an exit door absorbs it (doors with role "both")
@@ -55,7 +56,7 @@ class World:
         n_cols = {"ids": np.int64, "group": np.intp, "pos": (np.float64, 2), "vel": (np.float64, 2),
                   "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
                   "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64,
-                  "carry_offset": (np.float64, 2)}
+                  "carry_offset": (np.float64, 2), "carry_left": np.int64, "own_vel": (np.float64, 2)}
         self._cols = list(n_cols)
         for name, spec_ in n_cols.items():
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
@@ -65,6 +66,7 @@ class World:
         g = scenario.groups
         self._motion = np.array([MOTIONS.index(x.motion) for x in g])
         self._present_motions = {x.motion for x in g}
+        self._carrying = "carried" in self._present_motions or (scenario.world.carry_frames > 0 and not self.standing)
         self.texture_of_group = np.array([TEXTURES.index(x.texture) for x in g])
         self.layer_of_group = np.array([x.layer for x in g])
         self.shape_is_rect = np.array([x.shape == "rect" for x in g])
@@ -184,7 +186,8 @@ class World:
             cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
             goal=self._pick_goal(pos), stopped=False, born=self.t,
             carrier_id=0 if carrier is None else int(self.ids[carrier]),
-            carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier]))
+            carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier], carry_left=_FREE if carrier is None else _FOR_GOOD,
+            own_vel=vel))
         self.next_id += 1
         self.bodies.append(self._make_body(g, pos, vel, size, carrier))
         return size
@@ -271,7 +274,7 @@ class World:
             scale = self.depth_scale(self.pos[:, 1])[:, None]
             self.vel = body_vel / scale
             self._apply_motion()
-            out = self._carry(self.vel * scale) if "carried" in self._present_motions else self.vel * scale
+            out = self._carry(self.vel * scale) if self._carrying else self.vel * scale
             vel = data[:, 2:].copy()  # rows that are not targets (the static body) keep their own velocity
             vel[self._rows] = out[self._row_slot]
             buf = pbatch.Buffer()
@@ -281,8 +284,10 @@ class World:
         self.t += 1
         if len(self.ids):
             self.pos = self._slot_view(self._read_bodies())[:, :2]
-            if "carried" in self._present_motions:
+            if self._carrying:
                 self._pin_carried()
+            if self.sc.world.carry_frames > 0 and not self.standing:
+                self._pick_up_and_leave()
         self._remove(self._leaving())
         self._spawn_births()
 
@@ -307,6 +312,37 @@ class World:
         self.pos[carried] = self.pos[slot] + self.carry_offset[carried]
         for i in carried.tolist():
             self.bodies[i].position = tuple(self.pos[i])
+
+    def _pick_up_and_leave(self):
+        """The carry event: a free target whose box lies wholly inside the box of a moving target drawn over it starts
+        to ride with it (touching nothing) for world.carry_frames frames, then is left where it is, going on as it did
+        before, and is free again once nothing covers it. Targets of a `carried` group ride for good."""
+        riding = self.carry_left > 0
+        self.carry_left[riding] -= 1
+        for i in np.flatnonzero(riding & (self.carry_left == 0)).tolist():  # left: it goes on as it did before
+            self.carrier_id[i], self.vel[i], self.carry_left[i] = 0, self.own_vel[i], _LEFT
+            self.bodies[i].velocity = tuple(self.own_vel[i])
+            self._set_touching(i, True)
+        boxes, depth = self.boxes(), self.depth()
+        lo, hi = boxes[:, :2], boxes[:, :2] + boxes[:, 2:]
+        moving = (np.hypot(*self.vel.T) > 0.1) & (self.carrier_id == 0)
+        covers = ((lo[None] <= lo[:, None]) & (hi[None] >= hi[:, None])).all(axis=2) & (depth[None] > depth[:, None]) \
+            & moving[None]
+        np.fill_diagonal(covers, False)
+        covered = covers.any(axis=1)
+        self.carry_left[(self.carry_left == _LEFT) & ~covered] = _FREE  # uncovered since it was left: free again
+        for i in np.flatnonzero(covered & (self.carry_left == _FREE)).tolist():
+            j = int(np.flatnonzero(covers[i])[np.argmax(depth[covers[i]])])  # the topmost of its covers
+            self.carrier_id[i], self.carry_offset[i] = self.ids[j], self.pos[i] - self.pos[j]
+            self.carry_left[i], self.own_vel[i] = self.sc.world.carry_frames, self.vel[i]
+            self._set_touching(i, False)
+
+    def _set_touching(self, i: int, touching: bool):
+        """Let target i collide as its group does, or touch nothing (while it rides)."""
+        for shape in self.bodies[i].shapes:
+            bit = shape.filter.categories
+            mask = WALL_BIT | (0 if self.sc.world.collision == "none" else bit) if touching else 0
+            shape.filter = pymunk.ShapeFilter(categories=bit, mask=mask)
 
     def _apply_motion(self):
         """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""

@@ -1,10 +1,12 @@
 """The pymunk world: motion models, collisions, layers, carrying, births and deaths."""
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import still, tiny
+from mtt_sim.env import NO_TRACKS, TrackingEnv
 from mtt_sim.scenario import load
 from mtt_sim.world import World, _SpotGrid
 
@@ -149,3 +151,32 @@ def test_placing_targets_costs_linear_work(monkeypatch):
         world(load("dense", {"groups.0.count": n, "world.size": [side, side]}))
         work.append(sum(compared))
     assert work[1] < 6 * work[0], work
+
+
+def carry_scene(carry_frames: int):
+    """A small still book (layer 0) and a large book (layer 1) sliding right over it at 2 px a frame."""
+    small = {**still(size=(20.0, 20.0), name="small"), "region": [0.3, 0.5, 0.301, 0.501]}
+    large = {"name": "large", "count": 1, "shape": "rect", "size": [60.0, 60.0], "size_jitter": 0.0, "speed": 2.0,
+             "speed_jitter": 0.0, "heading": 0.0, "heading_jitter": 0.0, "accel": 0.0, "layer": 1,
+             "region": [0.1, 0.5, 0.101, 0.501]}
+    return tiny(groups=[small, large], render={"width": 400, "height": 200}, world={"walls": False, "carry_frames": carry_frames},
+                env={"max_steps": 200})
+
+
+@pytest.mark.parametrize("carry_frames", [0, 30])
+def test_a_completely_covered_target_rides_with_its_cover_for_carry_frames_then_is_left(carry_frames):
+    env = TrackingEnv(carry_scene(carry_frames))
+    env.reset(seed=0)
+    start = env.world.pos[0].copy()
+    path = []
+    for _ in range(120):
+        env.step(NO_TRACKS)
+        path.append(env.world.pos[0].copy())
+    moved = np.array(path) - start
+    if not carry_frames:
+        assert np.abs(moved).max() < 1e-9                      # covered, but it stays put
+        return
+    steps = np.flatnonzero(np.diff(moved[:, 0]) > 1.0)         # frames in which it moved with its cover
+    assert len(steps) == carry_frames and np.ptp(np.diff(steps)) == 0   # one run of carry_frames frames
+    assert moved[-1, 0] == pytest.approx(2.0 * carry_frames, abs=2.5) and abs(moved[-1, 1]) < 1e-6
+    assert env.world.carrier_id[0] == 0                        # left, touching again
