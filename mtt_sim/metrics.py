@@ -29,7 +29,7 @@ Semantics, following TrackEval where other tools differ:
   matches, pooled over targets (the error measure of the JPDA paper's Tables 3 and 4), in pixels.
 - Similarity "iou" is the box IoU; "centroid" is TrackEval's point similarity
   max(0, 1 - d / zero_distance) on box centres.
-- Occlusion windows (scenes whose truth is passed to `update` as `everyone`; nan, 0 otherwise). A target is
+- Occlusion windows (scenes whose truth is passed to `update` as `everyone`; None, 0 otherwise). A target is
   *hidden* in a frame where its visibility is below HIDDEN (0.05); its *holder* is the track CLEAR-matched to it
   in the latest frame it was matched (none before its first match).
   HiddenCentreError: the mean distance in pixels between a hidden target's box centre and its holder's reported
@@ -271,16 +271,15 @@ class _OcclusionWindows:
         decided[over, 0] += won[over]
         decided[over, 1] += 1
         stage[over], won[over] = _CLEAR, False
-        hidden = g[visibility < HIDDEN]
-        held = hidden[holder[hidden] >= 0]
+        at = np.flatnonzero((visibility < HIDDEN) & (holder[g] >= 0))  # rows of the hidden targets with a holder
+        held = g[at]
         starting = held[stage[held] == _CLEAR]
         stage[starting], owed[starting] = _HIDDEN, holder[starting]
         row_of = {i: r for r, i in enumerate(np.asarray(trk_ids).tolist())}
         row = np.array([row_of.get(h, -1) for h in holder[held].tolist()], np.intp)
         seen = row >= 0
         if seen.any():
-            where = np.flatnonzero(np.isin(g, held[seen]))  # the same order as held[seen]: both follow g
-            d = np.linalg.norm(centres(np.asarray(boxes)[where]) - centres(np.asarray(trk_boxes)[row[seen]]), axis=1)
+            d = np.linalg.norm(centres(np.asarray(boxes)[at[seen]]) - centres(np.asarray(trk_boxes)[row[seen]]), axis=1)
             error[held[seen], 0] += d
             error[held[seen], 1] += 1
         now = np.flatnonzero(matched_to >= 0)

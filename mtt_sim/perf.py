@@ -91,7 +91,8 @@ def report(rows: list[dict]) -> str:
     """Markdown table of `measure`'s rows."""
     return _table(f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background "
                   "copy and two filled ellipses per target (frame and label map)",
-                  ["targets", "steps/s with frames", "steps/s detections only", "reference frames/s", "step / reference"],
+                  ["targets", "steps/s with frames", "steps/s detections only", "reference frames/s",
+                   "step / reference"],
                   [[r["targets"], f"{r['frames_steps_per_s']:.0f}", f"{r['detections_steps_per_s']:.0f}",
                     f"{r['reference_per_s']:.0f}", f"{r['step_over_reference']:.2f}x"] for r in rows])
 
@@ -220,12 +221,11 @@ def measure_metrics(repeats: int = 5) -> list[dict]:
 
 def report_metrics(rows: list[dict]) -> str:
     """Markdown table of `measure_metrics`' rows."""
-    out = ["EpisodeMetrics cost, medians (reference: IoU matrix + one Hungarian assignment per frame)",
-           "| objects | frames | update per frame | reference per frame | update / reference | summary of all frames |",
-           "|---:|---:|---:|---:|---:|---:|"]
-    out += [f"| {r['objects']} | {r['frames']} | {r['update_us']:.0f} us | {r['reference_us']:.0f} us | "
-            f"{r['update_over_reference']:.2f}x | {r['summary_s'] * 1e3:.1f} ms |" for r in rows]
-    return "\n".join(out)
+    return _table("EpisodeMetrics cost, medians (reference: IoU matrix + one Hungarian assignment per frame)",
+                  ["objects", "frames", "update per frame", "reference per frame", "update / reference",
+                   "summary of all frames"],
+                  [[r["objects"], r["frames"], f"{r['update_us']:.0f} us", f"{r['reference_us']:.0f} us",
+                    f"{r['update_over_reference']:.2f}x", f"{r['summary_s'] * 1e3:.1f} ms"] for r in rows])
 
 
 def measure_metrics_memory(repeats: int = 5, objects: int = 200, frames: int = 3000) -> dict:
@@ -246,10 +246,10 @@ def measure_metrics_memory(repeats: int = 5, objects: int = 200, frames: int = 3
 
 
 def report_metrics_memory(row: dict) -> str:
-    return "\n".join(["EpisodeMetrics memory of a long episode (summary time: median)",
-                      "| objects | frames | stored per frame | summary | summary peak / stored |", "|---:|---:|---:|---:|---:|",
-                      f"| {row['objects']} | {row['frames']} | {row['kb_per_frame']:.1f} KB | {row['summary_s']:.2f} s | "
-                      f"{row['peak_over_stored']:.2f}x |"])
+    return _table("EpisodeMetrics memory of a long episode (summary time: median)",
+                  ["objects", "frames", "stored per frame", "summary", "summary peak / stored"],
+                  [[row["objects"], row["frames"], f"{row['kb_per_frame']:.1f} KB", f"{row['summary_s']:.2f} s",
+                    f"{row['peak_over_stored']:.2f}x"]])
 
 
 def _recorded_detections(n: int, frames: int, clutter: float = 5.0, with_frames: bool = False):
@@ -277,12 +277,12 @@ def measure_jpda(repeats: int = 5, frames: int = 150) -> list[dict]:
 
 
 def report_jpda(rows: list[dict]) -> str:
-    out = ["jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
-           "| targets | jpda ms/frame | gnn ms/frame | jpda / gnn |", "|---:|---:|---:|---:|"]
-    out += [f"| {r['targets']} | {r['jpda_ms']:.2f} | {r['gnn_ms']:.2f} | {r['jpda_over_gnn']:.2f}x |" for r in rows]
-    out += ["jpda's parameters (its defaults, as measured):"]
-    out += ["    " + line for line in trackers.base.describe("jpda")]
-    return "\n".join(out)
+    table = _table("jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
+                   ["targets", "jpda ms/frame", "gnn ms/frame", "jpda / gnn"],
+                   [[r["targets"], f"{r['jpda_ms']:.2f}", f"{r['gnn_ms']:.2f}", f"{r['jpda_over_gnn']:.2f}x"]
+                    for r in rows])
+    return "\n".join([table, "jpda's parameters (its defaults, as measured):",
+                      *("    " + line for line in trackers.base.describe("jpda"))])
 
 
 def measure_lmb(repeats: int = 5, frames: int = 100) -> list[dict]:
@@ -300,12 +300,11 @@ def measure_lmb(repeats: int = 5, frames: int = 100) -> list[dict]:
 
 
 def report_lmb(rows: list[dict]) -> str:
-    out = ["lmb tracker time per frame, medians (P_D 0.9, 10 clutter a frame; reference: gnn on the same detections)",
-           "| targets | detections/frame | lmb:reid=false ms/frame | lmb (re-id) ms/frame | gnn ms/frame | "
-           "lmb:reid=false / gnn |", "|---:|---:|---:|---:|---:|---:|"]
-    out += [f"| {r['targets']} | {r['detections']:.1f} | {r['lmb_ms']:.2f} | {r['lmb_reid_ms']:.2f} | {r['gnn_ms']:.2f} | "
-            f"{r['lmb_over_gnn']:.2f}x |" for r in rows]
-    return "\n".join(out)
+    return _table("lmb tracker time per frame, medians (P_D 0.9, 10 clutter a frame; reference: gnn on the same "
+                  "detections)", ["targets", "detections/frame", "lmb:reid=false ms/frame", "lmb (re-id) ms/frame",
+                                  "gnn ms/frame", "lmb:reid=false / gnn"],
+                  [[r["targets"], f"{r['detections']:.1f}", f"{r['lmb_ms']:.2f}", f"{r['lmb_reid_ms']:.2f}",
+                    f"{r['gnn_ms']:.2f}", f"{r['lmb_over_gnn']:.2f}x"] for r in rows])
 
 
 RFS_WORKLOADS = (("mot17_like", {}, ("gmphd",)),
@@ -403,13 +402,10 @@ def measure_pf(repeats: int = 5, frames: int = 60) -> list[dict]:
 
 
 def report_pf(rows: list[dict]) -> str:
-    lines = ["particle filters, tracker time only, medians",
-             "| tracker | frames/s | per-particle calcHist frames/s (its histogram only) | tracker / reference |",
-             "|---|---:|---:|---:|"]
-    lines += [f"| {r['tracker']} | {r['fps']:.0f} | {r['reference_fps']:.0f} | {r['fps'] / r['reference_fps']:.2f}x |"
-              for r in rows]
-    return "\n".join(lines)
-
+    return _table("particle filters, tracker time only, medians",
+                  ["tracker", "frames/s", "per-particle calcHist frames/s (its histogram only)", "tracker / reference"],
+                  [[r["tracker"], f"{r['fps']:.0f}", f"{r['reference_fps']:.0f}",
+                    f"{r['fps'] / r['reference_fps']:.2f}x"] for r in rows], left=1)
 
 SWEEP = (("sort", "gnn"), ("crossing", "soccer", "mot17_like"), 4)  # trackers, scenarios, seeds: 24 full episodes
 

@@ -433,8 +433,8 @@ class ForegroundSensor(Sensor):
 
 def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.ndarray):
     """Area, box x, y, w, h and summed `weights` of components 1..count-1 of label image `comp` (nonzero where `mask`
-    is), as floats. Read from the foreground pixels alone: cv2's own stats pass scans the whole image (on two
-    threads, for two thirds of a step's time on a mostly empty frame)."""
+    is), as floats. Read from the foreground pixels alone: cv2's own stats pass scans the whole image (about 1 ms
+    of a soccer step at 720x576, where the labelling itself takes 0.4 ms)."""
     xy = cv2.findNonZero(mask)
     xy = np.zeros((0, 2), np.int32) if xy is None else xy.reshape(-1, 2)
     x, y = xy[:, 0], xy[:, 1]

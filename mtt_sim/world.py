@@ -66,7 +66,8 @@ class World:
         g = scenario.groups
         self._motion = np.array([MOTIONS.index(x.motion) for x in g])
         self._present_motions = {x.motion for x in g}
-        self._carrying = "carried" in self._present_motions or (scenario.world.carry_frames > 0 and not self.standing)
+        self._picks_up = scenario.world.carry_frames > 0 and not self.standing  # the carry event (topdown only)
+        self._carrying = "carried" in self._present_motions or self._picks_up
         self.texture_of_group = np.array([TEXTURES.index(x.texture) for x in g])
         self.layer_of_group = np.array([x.layer for x in g])
         self.shape_is_rect = np.array([x.shape == "rect" for x in g])
@@ -186,8 +187,8 @@ class World:
             cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
             goal=self._pick_goal(pos), stopped=False, born=self.t,
             carrier_id=0 if carrier is None else int(self.ids[carrier]),
-            carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier], carry_left=_FREE if carrier is None else _FOR_GOOD,
-            own_vel=vel))
+            carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier],
+            carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel))
         self.next_id += 1
         self.bodies.append(self._make_body(g, pos, vel, size, carrier))
         return size
@@ -286,7 +287,7 @@ class World:
             self.pos = self._slot_view(self._read_bodies())[:, :2]
             if self._carrying:
                 self._pin_carried()
-            if self.sc.world.carry_frames > 0 and not self.standing:
+            if self._picks_up:
                 self._pick_up_and_leave()
         self._remove(self._leaving())
         self._spawn_births()

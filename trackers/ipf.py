@@ -18,7 +18,8 @@ def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.nda
     owner = np.repeat(np.arange(k), n)
     xy, half = centres.reshape(-1, 2), np.repeat(sizes / 2.0, n, axis=0)
     a, b = near_in_x_and_y(xy, _reach(sizes, ratio)[owner], xy)
-    a, b = a[owner[a] != owner[b]], b[owner[a] != owner[b]]
+    other = owner[a] != owner[b]
+    a, b = a[other], b[other]
     overlap = np.clip(np.minimum(xy[a] + half[a], xy[b] + half[b]) - np.maximum(xy[a] - half[a], xy[b] - half[b]), 0, None)
     area = np.prod(sizes, axis=1)
     hit = overlap[:, 0] * overlap[:, 1] > ratio * np.minimum(area[owner[a]], area[owner[b]])

