@@ -253,16 +253,25 @@ class _OcclusionWindows:
         self.frame = -1
 
     def update(self, ids, boxes, visibility, trk_ids, trk_boxes, matched_gt, matched_trk) -> None:
-        """One frame: every target in view (ids, boxes, visibility), the reported tracks, the CLEAR matches."""
+        """One frame: every target in view (ids, boxes, visibility), the reported tracks, the CLEAR matches. Most
+        frames have nobody hidden and no occlusion under way: they only note who holds whom."""
         self.frame += 1
-        g = self.ids(np.asarray(ids, np.int64))
+        g = self.ids(ids)
+        n = len(self.ids)
+        holder, stage = self.holder.ensure(n), self.stage.ensure(n)
+        matched_to = np.full(n, -1, np.int64)
+        matched_to[self.ids(matched_gt)] = matched_trk
+        if (visibility < HIDDEN).any() or stage[:n].any():
+            self._windows(g, boxes, visibility, trk_ids, trk_boxes, matched_to)
+        now = np.flatnonzero(matched_to >= 0)
+        holder[now] = matched_to[now]
+
+    def _windows(self, g, boxes, visibility, trk_ids, trk_boxes, matched_to) -> None:
+        """Open, reveal and decide occlusions, and add the hidden frames' centre errors."""
         n = len(self.ids)
         holder, stage, owed, deadline, won = (a.ensure(n) for a in (self.holder, self.stage, self.owed, self.deadline,
                                                                      self.won))
         error, decided = self.error.ensure(n), self.decided.ensure(n)
-        visibility = np.asarray(visibility, float)
-        matched_to = np.full(n, -1, np.int64)
-        matched_to[self.ids(np.asarray(matched_gt, np.int64))] = matched_trk
         revealed = g[(stage[g] == _HIDDEN) & (visibility >= REVEALED)]
         stage[revealed], deadline[revealed] = _WINDOW, self.frame + WINDOW - 1
         waiting = np.flatnonzero(stage[:n] == _WINDOW)
@@ -275,15 +284,13 @@ class _OcclusionWindows:
         held = g[at]
         starting = held[stage[held] == _CLEAR]
         stage[starting], owed[starting] = _HIDDEN, holder[starting]
-        row_of = {i: r for r, i in enumerate(np.asarray(trk_ids).tolist())}
+        row_of = {i: r for r, i in enumerate(trk_ids.tolist())}
         row = np.array([row_of.get(h, -1) for h in holder[held].tolist()], np.intp)
         seen = row >= 0
         if seen.any():
-            d = np.linalg.norm(centres(np.asarray(boxes)[at[seen]]) - centres(np.asarray(trk_boxes)[row[seen]]), axis=1)
+            d = np.linalg.norm(centres(boxes[at[seen]]) - centres(trk_boxes[row[seen]]), axis=1)
             error[held[seen], 0] += d
             error[held[seen], 1] += 1
-        now = np.flatnonzero(matched_to >= 0)
-        holder[now] = matched_to[now]
 
     def summary(self) -> dict:
         n = len(self.ids)
@@ -342,18 +349,20 @@ class EpisodeMetrics:
     def update(self, gt_ids, gt_boxes, trk_ids, trk_boxes, everyone=None) -> FrameStats:
         """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h. `everyone`:
         (ids, boxes, visibility) of every target in view, hidden ones too, for the occlusion windows."""
+        frame = len(self._episode)
+        gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, frame)
+        trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, frame)
         if everyone is not None:
-            everyone = _check_everyone(everyone, gt_ids, len(self._episode))
+            everyone = _check_everyone(everyone, gt_ids, frame)
         stats = self._score(gt_ids, gt_boxes, trk_ids, trk_boxes)
         if everyone is not None:
             rows, cols = self._pairs
-            self._occlusion.update(*everyone, trk_ids, trk_boxes, np.asarray(gt_ids)[rows], np.asarray(trk_ids)[cols])
+            self._occlusion.update(*everyone, trk_ids, trk_boxes, gt_ids[rows], trk_ids[cols])
         return stats
 
     def _score(self, gt_ids, gt_boxes, trk_ids, trk_boxes) -> FrameStats:
+        """The CLEAR and per-frame work of one validated frame; its matches are left in `_pairs`."""
         self._pairs = (_NONE, _NONE)
-        gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, len(self._episode))
-        trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, len(self._episode))
         g, t = self._gt_ids(gt_ids), self._trk_ids(trk_ids)
         sim = self._similarity(gt_boxes, trk_boxes)
         self._episode.add_frame(g, t, gt_boxes, trk_boxes, sim)
