@@ -34,20 +34,31 @@ def test_single_target_with_certain_detection_and_no_clutter_is_a_kalman_filter(
     x = P = None
     for k in range(15):
         z = (truth + [2.0 * k, 1.0 * k, 0, 0] + rng.normal(0, 1.5, 4)).astype(np.float32).astype(float)
-        if x is None:   # the plain filter: born at the first detection, then corrected by it (as lmb does)
+        if x is None:   # the plain filter: born at the first detection, which does not also correct it
             x, P = noise.birth(z[None])
             x, P = x[0], P[0]
         else:
             x = gm.F @ x
             P = gm.F @ P @ gm.F.T + noise.process_covariance(x[None])[0]
-        S = gm.H @ P @ gm.H.T + noise.measurement_covariance(x[None])[0]
-        K = P @ gm.H.T @ np.linalg.inv(S)
-        x, P = x + K @ (z - gm.H @ x), (np.eye(gm.DIM) - K @ gm.H) @ P
+            S = gm.H @ P @ gm.H.T + noise.measurement_covariance(x[None])[0]
+            K = P @ gm.H.T @ np.linalg.inv(S)
+            x, P = x + K @ (z - gm.H @ x), (np.eye(gm.DIM) - K @ gm.H) @ P
         tracks = lmb.update(obs_of([*z, 0.9]))
         assert len(tracks.ids) == 1 and tracks.ids[0] == 1
         np.testing.assert_allclose(tracks.boxes[0], x[:4], rtol=1e-6)
         np.testing.assert_allclose(lmb.tracks.m[0], x, rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(lmb.tracks.P[0], P, rtol=1e-9, atol=1e-9)
+
+
+def test_first_frame_detections_become_tracks_at_their_birth_existence_not_updated_by_themselves():
+    """Sec. 4.2.1: at k = 1 every detection becomes a track, with r_B = birth_max x confidence; a 0.1-confidence box
+    is not raised by its own detection (it was reported at r = 0.995)."""
+    lmb = trackers.make("lmb", reid=False)
+    lmb.reset(INFO)
+    tracks = lmb.update(obs_of([100, 100, 30, 60, 0.1], [300, 200, 30, 60, 0.9]))
+    np.testing.assert_allclose(lmb.tracks.r, [0.06, 0.54])
+    np.testing.assert_allclose(lmb.tracks.m[:, :4], [[100, 100, 30, 60], [300, 200, 30, 60]])
+    assert tracks.ids.tolist() == [2] and len(lmb.pending[0]) == 0   # only r > 0.5 is reported; no second birth
 
 
 def test_existence_decays_with_misses_at_the_rate_of_the_formula():

@@ -240,8 +240,6 @@ class LabelledMultiBernoulli(Tracker):
             dets = dets[dets[:, 4] >= p["low_confidence"]]
         z, conf = dets[:, :4], dets[:, 4]
         self.frame += 1
-        if self.frame == 1 and p["birth"] == "adaptive":  # at the first frame every detection starts a track
-            self.pending = (z, p["birth_max"] * conf)
         t.r = t.r * p["survival"]
         t.m, t.P = gm.predict(t.m, t.P, self.noise)
         self._births(dets)
@@ -276,11 +274,23 @@ class LabelledMultiBernoulli(Tracker):
         r_birth = self._birth_existence(np.clip(1 - associated, 0, 1), conf)
         fresh = r_birth > p["prune"]
         self.pending = (z[fresh], r_birth[fresh])
+        beta = beta[keep]
+        if self.frame == 1 and p["birth"] == "adaptive":
+            beta = self._first_tracks(z, r_birth)
         report = t.r > p["extract"]
         if self.metric is not None:
-            self._reidentify(frame_of(obs), report, beta[keep], dets)
+            self._reidentify(frame_of(obs), report, beta, dets)
         best = t.best()[report]
         return Tracks.of(t.label[report], t.m[best, :4], t.r[report])
+
+    def _first_tracks(self, z: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Sec. 4.2.1: at k = 1 there are no tracks yet, and every detection becomes one, with existence r_B. They
+        are born after the update, so the detection that bore a track does not update it too (which raised a
+        0.1-confidence box to r = 0.995). Returns beta for them: each took its own detection."""
+        m, P = self.noise.birth(z)
+        self.tracks.add(r, self._labels(len(z)), m, P)
+        self.pending = (np.zeros((0, 4)), np.zeros(0))
+        return np.concatenate([np.diag(r), np.zeros((len(z), 1))], axis=1)
 
     def _reidentify(self, frame: np.ndarray, report: np.ndarray, beta: np.ndarray, dets: np.ndarray) -> None:
         """Relabel tracks reported for the first time from the pool; then pool confident associated detections."""
@@ -288,8 +298,8 @@ class LabelledMultiBernoulli(Tracker):
         n_meas = len(dets)
         likely = np.argmax(beta[:, :n_meas], axis=1) if n_meas else np.zeros(len(t.r), int)
         held = beta[np.arange(len(t.r)), likely] > 0.5 * t.r if n_meas else np.zeros(len(t.r), bool)
-        if self.pool is None:
-            self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, int(report.sum())))
+        if self.pool is None:  # sec. 4.4: tp = tnum x T, T the targets born in the first frame (its detections)
+            self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, len(t.r)))
         new = np.flatnonzero(report & ~np.isin(t.label, list(self.reported)))
         if len(new) and self.frame > 1:
             boxes = np.where(held[new, None], dets[likely[new], :4] if n_meas else 0, t.m[t.best()[new], :4])
