@@ -77,6 +77,19 @@ def test_existence_decays_with_misses_at_the_rate_of_the_formula():
     assert all(a > b for a, b in zip(rates, rates[1:]))     # the less certain, the faster it fades... relatively
 
 
+def test_without_coasting_a_missed_track_is_not_reported_but_lives_on_with_its_label():
+    """coast=false (the ablation of the README's decomposition) hides a track the frame it is missed; the filter
+    itself is unchanged, so the track comes back under its label at the next detection."""
+    boxes = [[100.0 + 3 * k, 100, 30, 60, 0.9] for k in range(6)]
+    runs = {}
+    for coast in (True, False):
+        lmb = trackers.make("lmb", reid=False, coast=coast)
+        lmb.reset(INFO)
+        runs[coast] = [lmb.update(obs_of(*([] if k == 3 else [b]))).ids.tolist() for k, b in enumerate(boxes)]
+    assert runs[True] == [[1]] * 6
+    assert runs[False] == [[1], [1], [1], [], [1], [1]]
+
+
 def test_existence_rises_with_detections_at_the_rate_of_the_formula_and_a_birth_needs_an_unexplained_one():
     lmb = trackers.make("lmb", reid=False, clutter_rate=50.0, prune=0.05)  # no second birth at the same place
     lmb.reset(INFO)

@@ -130,9 +130,10 @@ class LabelledMultiBernoulli(Tracker):
     next frame with r_B = birth_max x confidence x (1 - probability the detection was associated), so a confident
     unexplained detection starts a likely track and a doubtful one an unlikely track (sec. 4.2.1): low-confidence
     detections stay in the filter. birth=fixed instead places `fixed_births` newborn components along the image
-    borders every frame (the traditional model). Tracks with r > `extract` are reported, tracks under `prune` are
-    dropped, and each keeps at most `max_components` components. use_low_confidence=false first drops detections
-    under `low_confidence` (the paper's Ours_2). Clutter is uniform over the image for x, y and over
+    borders every frame (the traditional model). Tracks with r > `extract` are reported (coast=false: only those
+    that took a measurement this frame, an ablation of coasting), tracks under `prune` are dropped, and each keeps
+    at most `max_components` components. use_low_confidence=false first drops detections under `low_confidence`
+    (the paper's Ours_2). Clutter is uniform over the image for x, y and over
     [0, W/4] x [0, H/2] for w, h, at `clutter_rate` per frame.
     Re-identification (sec. 3, 4.4; reid=false turns it off): every `pool_every` frames a reported track whose
     most likely measurement has confidence >= `reid_confidence` puts that detection's LOMO feature (XQDA-embedded)
@@ -160,6 +161,8 @@ class LabelledMultiBernoulli(Tracker):
         "fixed_births": Param(16, "[1, inf)", "newborn components a frame with birth=fixed"),
         "fixed_birth_r": Param(0.03, "(0, 1)", "their existence probability"),
         "extract": Param(0.5, "(0, 1)", "least existence probability of a reported track"),
+        "coast": Param(True, None, "report tracks through frames they are missed; false (an ablation, not the "
+                                   "paper): only tracks that took a measurement this frame"),
         "prune": Param(1e-3, "[0, 1)", "tracks less likely than this are dropped"),
         "max_components": Param(4, "[1, inf)", "most mixture components per track"),
         "use_low_confidence": Param(True, None, "keep detections under low_confidence (false: the paper's Ours_2 "
@@ -277,9 +280,12 @@ class LabelledMultiBernoulli(Tracker):
         beta = beta[keep]
         if self.frame == 1 and p["birth"] == "adaptive":
             beta = self._first_tracks(z, r_birth)
+        likely, held = self._likeliest_measurements(beta, len(dets))
         report = t.r > p["extract"]
+        if not p["coast"]:
+            report &= held
         if self.metric is not None:
-            self._reidentify(frame_of(obs), report, beta, dets)
+            self._reidentify(frame_of(obs), report, likely, held, dets)
         best = t.best()[report]
         return Tracks.of(t.label[report], t.m[best, :4], t.r[report])
 
@@ -292,12 +298,20 @@ class LabelledMultiBernoulli(Tracker):
         self.pending = (np.zeros((0, 4)), np.zeros(0))
         return np.concatenate([np.diag(r), np.zeros((len(z), 1))], axis=1)
 
-    def _reidentify(self, frame: np.ndarray, report: np.ndarray, beta: np.ndarray, dets: np.ndarray) -> None:
+    def _likeliest_measurements(self, beta: np.ndarray, n_meas: int) -> tuple[np.ndarray, np.ndarray]:
+        """Each track's likeliest measurement this frame, and whether it holds more than half the track's
+        existence (the track took it rather than being missed or taking another)."""
+        r = self.tracks.r
+        if not n_meas:
+            return np.zeros(len(r), int), np.zeros(len(r), bool)
+        likely = np.argmax(beta[:, :n_meas], axis=1)
+        return likely, beta[np.arange(len(r)), likely] > 0.5 * r
+
+    def _reidentify(self, frame: np.ndarray, report: np.ndarray, likely: np.ndarray, held: np.ndarray,
+                    dets: np.ndarray) -> None:
         """Relabel tracks reported for the first time from the pool; then pool confident associated detections."""
         p, t = self.params, self.tracks
         n_meas = len(dets)
-        likely = np.argmax(beta[:, :n_meas], axis=1) if n_meas else np.zeros(len(t.r), int)
-        held = beta[np.arange(len(t.r)), likely] > 0.5 * t.r if n_meas else np.zeros(len(t.r), bool)
         if self.pool is None:  # sec. 4.4: tp = tnum x T, T the targets born in the first frame (its detections)
             self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, len(t.r)))
         new = np.flatnonzero(report & ~np.isin(t.label, list(self.reported)))
