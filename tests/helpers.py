@@ -1,10 +1,14 @@
 """Small hand-made scenarios for tests whose answers are known."""
 
+from pathlib import Path
+
 import numpy as np
 
 from mtt_sim import scenario
 from mtt_sim.env import TrackingEnv
 
+EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"  # scenes of the README's experiments
+BOOKS_WITH_DECOY = str(EXPERIMENTS / "books_with_decoy.toml")  # `books` before issue 18: a carried top book
 IDEAL = {"preset": "ideal", "clutter_rate": 0.0, "merge_prob": 0.0, "fragment_prob": 0.0}
 
 
@@ -73,7 +77,6 @@ def write_sequence(folder, det=(), gt=None, length=None, size=(100, 80), images=
     considered, class, visibility) or None for none, optional seqinfo.ini and img1/ frames (each a flat grey
     level that encodes its frame number)."""
     import cv2
-    from pathlib import Path
 
     folder = Path(folder)
     (folder / "det").mkdir(parents=True, exist_ok=True)

@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mtt_sim
-from helpers import still, tiny
+from helpers import BOOKS_WITH_DECOY, still, tiny
 from mtt_sim import ActionError, ConfigError, TrackingEnv
 from mtt_sim.env import NO_TRACKS
 
@@ -277,7 +277,8 @@ def test_gospa_and_iou_rewards():
 
 
 def test_min_visibility_drops_hidden_targets_from_scoring():
-    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5, "scoring.min_visibility": 0.8})
+    decoy = {"scenario": BOOKS_WITH_DECOY}
+    _, frames, _ = episode("mtt_sim/Books-v0", **decoy, config={"env.max_steps": 5, "scoring.min_visibility": 0.8})
     assert all(f["num_gt"] < 4 for f in frames)  # the large book, 72 % visible under the top book, is not scored
-    _, frames, _ = episode("mtt_sim/Books-v0", config={"env.max_steps": 5})
+    _, frames, _ = episode("mtt_sim/Books-v0", **decoy, config={"env.max_steps": 5})
     assert all(f["num_gt"] == 4 for f in frames)

@@ -1,7 +1,6 @@
 """The interactive particle filter (Liu et al. 2011): the conflict set by hand, and runs through gym.make."""
 
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackers
-from helpers import run_tracker, tiny
+from helpers import EXPERIMENTS, run_tracker, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from trackers.ipf import conflict_set
 
@@ -100,9 +99,6 @@ def test_runs_and_is_reproducible_with_and_without_interaction():
     clouds = tracker.debug()
     assert len(clouds) == 4 and clouds[0]["xy"].shape == (30, 2)
     np.testing.assert_allclose([cl["weights"].sum() for cl in clouds], 1.0)
-
-
-EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"
 
 
 def final_errors(sc, spec):

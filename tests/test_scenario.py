@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import BOOKS_WITH_DECOY
 from mtt_sim import scenario
 from mtt_sim.scenario import ConfigError, load
 
@@ -42,7 +43,7 @@ def test_bad_values_name_the_file_the_key_and_what_is_allowed(overrides, pattern
 
 def test_cross_field_rules():
     with pytest.raises(ConfigError, match=r"groups\.2\.carrier = 'nobody': must name another group"):
-        load("books", {"groups.2.carrier": "nobody"})
+        load(BOOKS_WITH_DECOY, {"groups.2.carrier": "nobody"})
     for camera in ("pan", "follow"):
         with pytest.raises(ConfigError, match=r"foreground' needs a static or shaking camera"):
             load("crossing", {"render.camera": camera})

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helpers import still, tiny
+from helpers import BOOKS_WITH_DECOY, still, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from mtt_sim.scenario import load
 from mtt_sim.world import World, _SpotGrid
@@ -47,8 +47,8 @@ def test_without_walls_targets_leave_and_die():
 
 def test_carried_target_keeps_its_offset_to_the_carrier_even_against_a_wall():
     # the carrier runs straight into the right wall and is held there; the book it carries must not slide off
-    w = world(load("books", {"groups.1.motion": "cv", "groups.1.heading": 0.0, "groups.1.heading_jitter": 0.0,
-                             "groups.1.speed": 6.0, "groups.1.accel": 0.0}))
+    w = world(load(BOOKS_WITH_DECOY, {"groups.1.motion": "cv", "groups.1.heading": 0.0,
+                                      "groups.1.heading_jitter": 0.0, "groups.1.speed": 6.0, "groups.1.accel": 0.0}))
     carried = int(np.flatnonzero(w.carrier_id)[0])
     carrier = int(np.flatnonzero(w.ids == w.carrier_id[carried])[0])
     offset = w.pos[carried] - w.pos[carrier]
