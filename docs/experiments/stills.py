@@ -15,7 +15,7 @@ from mtt_sim.experiment import run_episodes
 STILLS = [  # (scenario, tracker, file, frame, seed, render scale)
     ("crossing", "jpda", "docs/still_jpda_crossing.jpg", 60, 1, 2),
     ("umbrellas", "pf", "docs/still_pf_umbrellas.jpg", 40, 0, 1),
-    ("books", "ipf", "docs/still_ipf_books.jpg", 45, 0, 1),
+    ("books", "ipf:samples=0", "docs/still_ipf_books.jpg", 60, 1, 1),
     ("mot17_like", "lmb", "docs/still_lmb_mot17_like.jpg", 60, 0, 1),
     ("mot17_like", "bytetrack", "docs/demo.jpg", 120, 0, 1),
 ]
