@@ -61,6 +61,16 @@ def test_first_frame_detections_become_tracks_at_their_birth_existence_not_updat
     assert tracks.ids.tolist() == [2] and len(lmb.pending[0]) == 0   # only r > 0.5 is reported; no second birth
 
 
+@pytest.mark.parametrize("birth", ["adaptive", "fixed"])
+def test_the_reid_pool_holds_ten_features_per_target_detected_in_the_first_frame(birth):
+    """Sec. 4.4: tp = tnum x T; fixed birth's 16 border components at frame 1 are not targets."""
+    lmb = trackers.make("lmb", birth=birth)
+    lmb.reset(INFO)
+    lmb.update({**obs_of([100, 100, 30, 60, 0.9], [300, 200, 30, 60, 0.9], [500, 300, 30, 60, 0.4]),
+                "frame": np.zeros((480, 640, 3), np.uint8)})
+    assert lmb.pool.items.maxlen == 30
+
+
 def test_existence_decays_with_misses_at_the_rate_of_the_formula():
     lmb = trackers.make("lmb", detection=0.8, survival=0.95, prune=1e-9, reid=False)
     lmb.reset(INFO)

@@ -312,8 +312,8 @@ class LabelledMultiBernoulli(Tracker):
         """Relabel tracks reported for the first time from the pool; then pool confident associated detections."""
         p, t = self.params, self.tracks
         n_meas = len(dets)
-        if self.pool is None:  # sec. 4.4: tp = tnum x T, T the targets born in the first frame (its detections)
-            self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, len(t.r)))
+        if self.pool is None:  # sec. 4.4: tp = tnum x T, T the targets detected in the first frame (not fixed
+            self.pool = reid.FeaturePool(p["pool_per_target"] * max(1, n_meas))  # birth's border components)
         new = np.flatnonzero(report & ~np.isin(t.label, list(self.reported)))
         if len(new) and self.frame > 1:
             boxes = np.where(held[new, None], dets[likely[new], :4] if n_meas else 0, t.m[t.best()[new], :4])
