@@ -146,7 +146,7 @@ def test_path_consistency_baseline_coasts_through_a_static_occluder():
 
 def test_occlusion_windows_see_the_interactive_filter_take_a_hidden_book_back_and_independent_filters_not():
     sc = str(EXPERIMENTS / "lookalike_crossing.toml")
-    kept, lost = (run_tracker(spec, sc, {"env.max_steps": 90}, obs_mode="frame+detections")[0]  # room for the window
+    kept, lost = (run_tracker(spec, sc, obs_mode="frame+detections")[0]  # 90 steps: room for the window
                   for spec in ("ipf", "ipf:interactive=false"))
     assert kept["Occlusions"] == lost["Occlusions"] == 1
     assert kept["Reacquired"] == 1.0 and lost["Reacquired"] == 0.0
