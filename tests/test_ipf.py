@@ -83,7 +83,7 @@ def test_propagation_from_the_estimate_or_from_the_resampled_particles(spec):
 
 
 def test_the_step_spread_reads_delta_as_a_deviation_or_as_a_variance():
-    info = {"init_ids": np.array([1]), "init_boxes": np.array([[0.0, 0.0, 80.0, 125.0]])}
+    info = {"init_ids": np.array([1]), "init_boxes": np.array([[0.0, 0.0, 80.0, 125.0]]), "image_size": (640, 480)}
     std, variance = trackers.make("ipf"), trackers.make("ipf:spread=variance")
     std.reset(info)
     variance.reset(info)
@@ -151,3 +151,16 @@ def test_occlusion_windows_see_the_interactive_filter_take_a_hidden_book_back_an
     assert kept["Occlusions"] == lost["Occlusions"] == 1
     assert kept["Reacquired"] == 1.0 and lost["Reacquired"] == 0.0
     assert kept["HiddenCentreError"] < lost["HiddenCentreError"]
+
+
+@pytest.mark.parametrize("spec", ["pcpf", "ipf"])
+def test_estimates_stay_inside_the_image_when_a_target_leaves_it(spec):
+    """A book runs out of the right edge; pcpf coasts on its velocity and ipf's particles wander. The filters' state
+    is a position in the image, so the estimate stops at the border; it used to run past the action space."""
+    book = {"name": "b", "count": 1, "shape": "rect", "size": [30.0, 30.0], "size_jitter": 0.0, "speed": 4.0,
+            "speed_jitter": 0.0, "heading": 0.0, "heading_jitter": 0.0, "accel": 0.0, "region": [0.7, 0.5, 0.701, 0.501],
+            "color": [40, 160, 60], "similarity": 1.0, "texture": "checks"}
+    sc = tiny(groups=[book], render={"width": 200, "height": 100, "background": "noise", "noise": 3.0},
+              world={"walls": False}, env={"max_steps": 200})
+    _, tracker = run_tracker(spec, sc, obs_mode="frame+detections")
+    assert ((tracker.estimates >= 0) & (tracker.estimates <= [200, 100])).all()

@@ -193,6 +193,14 @@ def test_malformed_initial_boxes_get_one_clear_error(info):
             trackers.make(spec).reset(info)
 
 
+@pytest.mark.parametrize("size", [None, (640,), (0, 480), (np.nan, 480)])
+def test_the_interactive_filters_need_the_image_size(size):
+    info = {"init_ids": [1], "init_boxes": [[0, 0, 5, 5]], **({"image_size": size} if size is not None else {})}
+    for spec in ("ipf", "pcpf"):
+        with pytest.raises(ValueError, match=r"needs env.reset's info\['image_size'\]: \(width, height\)"):
+            trackers.make(spec).reset(info)
+
+
 def test_tracks_to_action_pads_and_drops_degenerate_boxes():
     tracks = trackers.Tracks.of([3, 4, 5], [[0, 0, 5, 5], [1, 1, 0, 5], [2, 2, 3, 3]])
     env = gym.make("mtt_sim/Crossing-v0")

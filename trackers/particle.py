@@ -28,6 +28,14 @@ def initial_targets(info) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return ids.astype(np.int64), boxes[:, :2] + boxes[:, 2:] / 2, sizes
 
 
+def image_size(info) -> np.ndarray:
+    """(W, H) of env.reset's info["image_size"], checked: the box a particle filter's state may lie in."""
+    size = np.asarray((info if isinstance(info, Mapping) else {}).get("image_size", ()), float)
+    if size.shape != (2,) or not np.isfinite(size).all() or (size <= 0).any():
+        raise ValueError("a particle filter needs env.reset's info['image_size']: (width, height), both positive")
+    return size
+
+
 def crop_around(frame: np.ndarray, centres: np.ndarray, size) -> tuple[np.ndarray, np.ndarray]:
     """(origin, crop): the part of the frame holding every w x h region centred at `centres` (n, 2), with a
     2-pixel margin for gradients; features of the whole frame would cost far more than those of these pixels."""
