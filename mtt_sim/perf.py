@@ -352,7 +352,7 @@ def _particle_filter_row(label: str, spec: str, scenario: str, targets: int, par
     """Frames per second of `spec` on the first `targets` hand-initialised targets, against `reference(obs, boxes)`:
     the per-particle way, one cv2.calcHist call per particle region."""
     info, recorded = _recorded(scenario, frames, config)
-    first = {"init_ids": info["init_ids"][:targets], "init_boxes": info["init_boxes"][:targets]}
+    first = {**info, "init_ids": info["init_ids"][:targets], "init_boxes": info["init_boxes"][:targets]}
     boxes = np.round(first["init_boxes"]).astype(int)
 
     def tracker_run():
