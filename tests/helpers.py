@@ -25,6 +25,15 @@ def tiny(groups=None, occluders=(), sensor=None, **tables) -> scenario.Scenario:
     return scenario.from_mapping(raw, "tiny")
 
 
+def leaving_book(steps=200) -> scenario.Scenario:
+    """A textured book that runs out of the right edge of a 200x100 noisy scene and is gone for most of the episode."""
+    book = {"name": "b", "count": 1, "shape": "rect", "size": [30.0, 30.0], "size_jitter": 0.0, "speed": 4.0,
+            "speed_jitter": 0.0, "heading": 0.0, "heading_jitter": 0.0, "accel": 0.0, "region": [0.7, 0.5, 0.701, 0.501],
+            "color": [40, 160, 60], "similarity": 1.0, "texture": "checks"}
+    return tiny(groups=[book], render={"width": 200, "height": 100, "background": "noise", "noise": 3.0},
+                world={"walls": False}, env={"max_steps": steps})
+
+
 def still(count=1, shape="ellipse", size=(40.0, 40.0), layer=0, name="g"):
     """A group of motionless targets."""
     return {"name": name, "count": count, "shape": shape, "size": list(size), "size_jitter": 0.0, "speed": 0.0,

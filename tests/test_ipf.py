@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackers
-from helpers import EXPERIMENTS, run_tracker, tiny
+from helpers import EXPERIMENTS, leaving_book, run_tracker, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from trackers.ipf import conflict_set
 
@@ -157,10 +157,5 @@ def test_occlusion_windows_see_the_interactive_filter_take_a_hidden_book_back_an
 def test_estimates_stay_inside_the_image_when_a_target_leaves_it(spec):
     """A book runs out of the right edge; pcpf coasts on its velocity and ipf's particles wander. The filters' state
     is a position in the image, so the estimate stops at the border; it used to run past the action space."""
-    book = {"name": "b", "count": 1, "shape": "rect", "size": [30.0, 30.0], "size_jitter": 0.0, "speed": 4.0,
-            "speed_jitter": 0.0, "heading": 0.0, "heading_jitter": 0.0, "accel": 0.0, "region": [0.7, 0.5, 0.701, 0.501],
-            "color": [40, 160, 60], "similarity": 1.0, "texture": "checks"}
-    sc = tiny(groups=[book], render={"width": 200, "height": 100, "background": "noise", "noise": 3.0},
-              world={"walls": False}, env={"max_steps": 200})
-    _, tracker = run_tracker(spec, sc, obs_mode="frame+detections")
+    _, tracker = run_tracker(spec, leaving_book(), obs_mode="frame+detections")
     assert ((tracker.estimates >= 0) & (tracker.estimates <= [200, 100])).all()

@@ -6,7 +6,7 @@ import pytest
 
 import mtt_sim  # noqa: F401  (registers the env ids)
 import trackers
-from helpers import run_tracker
+from helpers import leaving_book, run_tracker
 from trackers.particle import systematic_resample
 
 
@@ -43,3 +43,10 @@ def test_systematic_resampling_keeps_heavy_particles():
     rng = np.random.default_rng(0)
     picks = systematic_resample(np.array([[0.0, 1.0, 0.0, 0.0], [0.25, 0.25, 0.25, 0.25]]), rng)
     assert picks[0].tolist() == [1, 1, 1, 1] and sorted(picks[1].tolist()) == [0, 1, 2, 3]
+
+
+def test_particles_stay_inside_the_image_when_their_target_leaves_it():
+    """The book runs out of the right edge; the particles' velocities would carry them off without bound."""
+    _, tracker = run_tracker("pf", leaving_book(), obs_mode="frame+detections")
+    xy = tracker.particles[:, :, :2]
+    assert ((xy >= 0) & (xy <= [200, 100])).all() and (xy[..., 0] > 150).any()

@@ -64,6 +64,8 @@ class ColourTextureParticleFilter(Tracker):
     exp(-mu e^2), e the Euclidean distance of the descriptors (eq. 7), fused as p_color^alpha p_texture^(1-alpha)
     (eq. 8; alpha = 1 is colour only). The estimate is the weighted mean; the templates are updated with beta
     (eq. 9-10) only when the estimate's likelihood exceeds update_threshold, so occluders do not enter them.
+    Particles' positions are kept inside the image (a deviation: the paper does not say, and a drifting velocity
+    would otherwise carry a lost target's particles off without bound).
     The paper's lam = 0.02 and mu = 0.01 make both likelihoods nearly flat at our scales (d^2 lies in [0, 1], e^2
     in [0, 4]), so the defaults are 20 and 10; pass lam=0.02,mu=0.01 for the paper's values."""
 
@@ -85,6 +87,7 @@ class ColourTextureParticleFilter(Tracker):
 
     def reset(self, info=None):
         self.ids, self.start, self.sizes = initial_targets(info)
+        self.image_size = image_size(info)
         self.rng = np.random.default_rng(self.params["seed"])
         self.particles = None  # (targets, N, 4), made at the first frame
         self.templates: list[tuple[np.ndarray, np.ndarray]] = []
@@ -133,6 +136,7 @@ class ColourTextureParticleFilter(Tracker):
             self.particles[:, :, :2] += self.particles[:, :, 2:]
             self.particles += self.rng.normal(0, 1, (k, n, 4)) * [p["pos_sigma"], p["pos_sigma"], p["vel_sigma"],
                                                                   p["vel_sigma"]]
+        self.particles[:, :, :2] = np.clip(self.particles[:, :, :2], 0, self.image_size)  # positions in the image
         weights = np.ones((k, n)) / n
         estimates, scores = np.zeros((k, 4)), np.zeros(k)
         for t in range(k):  # targets differ in region size; every particle of a target is one batched call
