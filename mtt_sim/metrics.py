@@ -284,8 +284,7 @@ class _OcclusionWindows:
         held = g[at]
         starting = held[stage[held] == _CLEAR]
         stage[starting], owed[starting] = _HIDDEN, holder[starting]
-        row_of = {i: r for r, i in enumerate(trk_ids.tolist())}
-        row = np.array([row_of.get(h, -1) for h in holder[held].tolist()], np.intp)
+        row = rows_of(trk_ids, holder[held])  # each holder's row among the reported tracks, -1 if not reported
         seen = row >= 0
         if seen.any():
             d = np.linalg.norm(centres(boxes[at[seen]]) - centres(trk_boxes[row[seen]]), axis=1)
@@ -303,6 +302,15 @@ class _OcclusionWindows:
         error, decided = self.error.ensure(n), self.decided.ensure(n)
         return {i: {"HiddenCentreError": _ratio(error[k, 0], error[k, 1]),
                     "Reacquired": _ratio(decided[k, 0], decided[k, 1])} for i, k in self.ids.index.items()}
+
+
+def rows_of(ids: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Row of each wanted id in `ids` (unique), or -1."""
+    if not len(ids):
+        return np.full(len(wanted), -1)
+    order = np.argsort(ids)
+    pos = np.minimum(np.searchsorted(ids, wanted, sorter=order), len(ids) - 1)
+    return np.where(ids[order[pos]] == wanted, order[pos], -1)
 
 
 def _ratio(a: float, b: float) -> float | None:

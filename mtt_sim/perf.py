@@ -407,6 +407,7 @@ def report_pf(rows: list[dict]) -> str:
                   [[r["tracker"], f"{r['fps']:.0f}", f"{r['reference_fps']:.0f}",
                     f"{r['fps'] / r['reference_fps']:.2f}x"] for r in rows], left=1)
 
+
 SWEEP = (("sort", "gnn"), ("crossing", "soccer", "mot17_like"), 4)  # trackers, scenarios, seeds: 24 full episodes
 
 

@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 from scipy.special import expit, logit
 
+from .metrics import rows_of
 from .scenario import Scenario, SensorConfig
 from .truth import Truth, clip_boxes, overlapping_pairs
 
@@ -203,7 +204,7 @@ class _Memory:
 
     def recall(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(known, state, drift, outlier offsets, ease) for each id; unknown ids get MISSED and zeros."""
-        row = _rows_of(self.ids, ids)
+        row = rows_of(self.ids, ids)
         known = row >= 0
         values, state = np.zeros((len(ids), 9)), np.full(len(ids), MISSED, np.int8)
         values[known], state[known] = self.values[row[known]], self.state[row[known]]
@@ -229,7 +230,7 @@ class _Sites:
         if not rate and not len(self.owner):
             return np.zeros((0, 4))
         visible = truth.visibility > cfg.min_visibility
-        row = _rows_of(truth.ids, self.owner)
+        row = rows_of(truth.ids, self.owner)
         keep = (rng.random(len(self.owner)) >= 1 / life) & ((self.owner < 0) | (row >= 0))
         n = rng.poisson(rate)
         beside = (rng.random(n) < cfg.site_near) & visible.any()
@@ -238,27 +239,18 @@ class _Sites:
         owner[beside] = targets
         shape = np.zeros((n, 4))
         if beside.any():
-            shape[beside] = astray(truth.boxes[_rows_of(truth.ids, targets)].astype(float), cfg.box_outlier_noise,
+            shape[beside] = astray(truth.boxes[rows_of(truth.ids, targets)].astype(float), cfg.box_outlier_noise,
                                    BESIDE_BAND, rng)
         shape[~beside] = sensor.random_boxes(int((~beside).sum()), truth)
         self.owner = np.concatenate([self.owner[keep], owner])
         self.shape = np.concatenate([self.shape[keep], shape])
-        row = _rows_of(truth.ids, self.owner)
+        row = rows_of(truth.ids, self.owner)
         static = self.owner < 0
         shown = static | ((row >= 0) & np.append(visible, False)[row])  # row -1 picks the False
         held = shown & ~static
         out = self.shape[shown].copy()
         out[held[shown]] = displace(truth.boxes[row[held]].astype(float), self.shape[held])
         return out
-
-
-def _rows_of(ids: np.ndarray, wanted: np.ndarray) -> np.ndarray:
-    """Row of each wanted id in `ids` (unique), or -1."""
-    if not len(ids):
-        return np.full(len(wanted), -1)
-    order = np.argsort(ids)
-    pos = np.minimum(np.searchsorted(ids, wanted, sorter=order), len(ids) - 1)
-    return np.where(ids[order[pos]] == wanted, order[pos], -1)
 
 
 class SyntheticSensor(Sensor):

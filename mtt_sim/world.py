@@ -213,12 +213,8 @@ class World:
         else:
             shape = pymunk.Circle(body, 0.5 * min(size))
         shape.elasticity, shape.friction = self._elasticity, 0.0
-        bit = 1 << g.layer
-        if carrier is not None:  # it rides on its carrier (pinned after each step) and touches nothing
-            mask = 0
-        else:
-            mask = WALL_BIT | (0 if self.sc.world.collision == "none" else bit)
-        shape.filter = pymunk.ShapeFilter(categories=bit, mask=mask)
+        # a carried target rides on its carrier (pinned after each step) and touches nothing
+        shape.filter = self._collision_filter(1 << g.layer, touching=carrier is None)
         self.space.add(body, shape)
         return body
 
@@ -341,9 +337,12 @@ class World:
     def _set_touching(self, i: int, touching: bool):
         """Let target i collide as its group does, or touch nothing (while it rides)."""
         for shape in self.bodies[i].shapes:
-            bit = shape.filter.categories
-            mask = WALL_BIT | (0 if self.sc.world.collision == "none" else bit) if touching else 0
-            shape.filter = pymunk.ShapeFilter(categories=bit, mask=mask)
+            shape.filter = self._collision_filter(shape.filter.categories, touching)
+
+    def _collision_filter(self, layer_bit: int, touching: bool) -> pymunk.ShapeFilter:
+        """A target's filter: it meets the walls and (unless collision is "none") its own layer, or nothing."""
+        mask = WALL_BIT | (0 if self.sc.world.collision == "none" else layer_bit) if touching else 0
+        return pymunk.ShapeFilter(categories=layer_bit, mask=mask)
 
     def _apply_motion(self):
         """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""

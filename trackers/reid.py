@@ -83,9 +83,9 @@ def lomo(crops) -> np.ndarray:
         texture += [_pooled_histograms(_siltp(grey, r), 81) for r in (1, 2)]
         imgs = _each(imgs, lambda one: cv2.resize(one, (one.shape[1] // 2, one.shape[0] // 2), interpolation=cv2.INTER_AREA))
     parts = [np.log1p(np.concatenate(p, axis=1).astype(np.float32)) for p in (colour, texture)]
+    # each row's norm on its own: norm(p, axis=1) sums in another order and differs in the last bit from one crop's
+    # feature, which the shipped metric and the published results were computed with
     return np.concatenate([p / np.maximum([np.linalg.norm(row) for row in p], 1e-12)[:, None] for p in parts], axis=1)
-
-
 
 
 def crops(frame: np.ndarray, boxes: np.ndarray) -> list[np.ndarray]:
