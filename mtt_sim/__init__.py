@@ -8,7 +8,8 @@ from importlib import metadata
 
 from gymnasium.envs.registration import register, registry
 
-from .scenario import ConfigError, Scenario, available, load, shipped_names
+from mtt_sim.sim.config import ConfigError, Scenario
+from mtt_sim.sim.scenario import available, load, shipped_names
 
 __version__ = metadata.version("mtt-sim")
 
@@ -27,7 +28,7 @@ if "mtt_sim/Replay-v0" not in registry:  # a recorded sequence: gym.make("mtt_si
 
 def __getattr__(name: str):
     if name in ("TrackingEnv", "ActionError"):
-        from . import env
+        from mtt_sim import env
 
         return getattr(env, name)
     raise AttributeError(f"module 'mtt_sim' has no attribute {name!r}")

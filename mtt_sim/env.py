@@ -17,16 +17,16 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from . import scenario as scn
-from . import viewer
-from .scenario import is_sequence
-from .sequence import Recording
-from .metrics import EpisodeMetrics, FrameStats
-from .overlay import draw_banner, draw_debug, draw_legend, draw_overlay, running_metrics
-from .render import Renderer
-from .sensor import Detections, SyntheticSensor, make_sensor
-from .truth import Truth, measure
-from .world import World
+from mtt_sim.sim import scenario as scn
+from mtt_sim.show import viewer
+from mtt_sim.sim.scenario import is_sequence
+from mtt_sim.real.sequence import Recording
+from mtt_sim.metrics import EpisodeMetrics, FrameStats
+from mtt_sim.show.overlay import draw_banner, draw_debug, draw_legend, draw_overlay, running_metrics
+from mtt_sim.sim.render import Renderer
+from mtt_sim.sim.sensor import Detections, SyntheticSensor, make_sensor
+from mtt_sim.sim.truth import Truth, measure
+from mtt_sim.sim.world import World
 
 _SPACE_KEYS = ("render.width", "render.height", "sensor.model", "sensor.max_detections", "sensor.conf_offset",
                "sensor.conf_scale", "env.max_tracks", "env.obs_mode")

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtt_sim import scenario
+from mtt_sim.sim import scenario
 from mtt_sim.env import TrackingEnv
 
 EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"  # scenes of the README's experiments
@@ -55,7 +55,7 @@ def run_tracker(spec, env_id, config=None, seed=0, obs_mode="detections"):
     import gymnasium as gym
 
     import mtt_sim  # noqa: F401  (registers the env ids)
-    import trackers
+    from mtt_sim import trackers
 
     registered = isinstance(env_id, str) and env_id.startswith("mtt_sim/")
     env = gym.make(env_id, obs_mode=obs_mode, config=config or {}) if registered else \

@@ -9,9 +9,13 @@ import pytest
 
 import mtt_sim  # noqa: F401  (registers the env ids)
 from helpers import write_sequence
-from mtt_sim import calibrate, cli, motchallenge, scenario, validate
+from mtt_sim import cli
+from mtt_sim.real import calibrate
+from mtt_sim.real import motchallenge
+from mtt_sim.sim import scenario
+from mtt_sim.real import validate
 from mtt_sim.env import NO_TRACKS
-from mtt_sim.truth import Truth
+from mtt_sim.sim.truth import Truth
 
 KNOWN = {"model": "synthetic", "pd": 0.85, "pd_spread": 0.8, "miss_corr": 0.6, "visibility_slope": 3.0, "reference_height": 100.0,
          "min_visibility": 0.0, "box_noise": 0.03, "box_size_noise": 0.03, "box_drift": 0.05, "box_size_drift": 0.1,

@@ -11,8 +11,11 @@ import sys
 import cv2
 import pytest
 
-import trackers
-from mtt_sim import cli, experiment, perf, scenario
+from mtt_sim import trackers
+from mtt_sim import cli
+from mtt_sim.lab import experiment
+from mtt_sim.lab import perf
+from mtt_sim.sim import scenario
 
 
 def mtt_sim(*args):
@@ -261,7 +264,7 @@ def test_sweep_and_bench_plot_one_panel_per_metric(tmp_path, capsys):
 def test_plot_intervals_stop_at_what_the_metric_can_take():
     import numpy as np
 
-    from mtt_sim.plots import clipped_errors
+    from mtt_sim.lab.plots import clipped_errors
 
     np.testing.assert_allclose(clipped_errors("IDF1", np.array([0.9, 0.05]), np.array([0.2, 0.2])),
                                [[0.2, 0.05], [0.1, 0.2]])

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from mtt_sim import scenario
+from mtt_sim.sim import scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 

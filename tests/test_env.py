@@ -50,7 +50,7 @@ def test_the_readme_example_runs():
 def test_render_draws_the_tracks_and_drawings_handed_over_on_the_frame_they_answer():
     """The agent hands its tracks, its tracker's debug() drawings and its name to the env before stepping; render()
     after the step shows them on the frame they answered, in the track's colour, enlarged render_scale times."""
-    from mtt_sim.overlay import track_color
+    from mtt_sim.show.overlay import track_color
 
     env = gym.make("mtt_sim/Crossing-v0", render_mode="rgb_array", render_scale=2)
     obs, _ = env.reset(seed=0)

@@ -11,9 +11,10 @@ from pathlib import Path
 
 import pytest
 
-import trackers
+from mtt_sim import trackers
 from helpers import fail_on_two
-from mtt_sim import experiment, pool
+from mtt_sim.lab import experiment
+from mtt_sim.lab import pool
 
 
 def strip_speed(records):

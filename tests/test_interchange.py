@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 import mtt_sim
-import trackers
-from mtt_sim import cli, motchallenge, sequence as seq
+from mtt_sim import trackers
+from mtt_sim import cli
+from mtt_sim.real import motchallenge
+from mtt_sim.real import sequence as seq
 from mtt_sim.env import TrackingEnv
 
 STEPS = 40

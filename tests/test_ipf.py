@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import trackers
+from mtt_sim import trackers
 from helpers import EXPERIMENTS, leaving_book, run_tracker, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
-from trackers.ipf import conflict_set
+from mtt_sim.trackers.ipf import conflict_set
 
 
 def test_conflict_set_on_hand_placed_regions():

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trackers.jpda import _all_events, _factors, association_probabilities
+from mtt_sim.trackers.jpda import _all_events, _factors, association_probabilities
 
 
 def test_the_papers_two_by_two_example():
@@ -75,7 +75,7 @@ def test_k_best_converges_to_exact_and_equals_it_with_every_event(problem):
 @given(problems(), st.integers(1, 12))
 def test_murty_finds_the_k_heaviest_joint_events(problem, k):
     """The enumeration shortcut for small clusters and Murty agree on which events are the k best."""
-    from trackers.jpda import _best_events
+    from mtt_sim.trackers.jpda import _best_events
     w, miss = _factors(*problem)
     heaviest = sorted((weight for _, weight in _all_events(w, miss)), reverse=True)[:k]
     found = [weight for _, weight in _best_events(w, miss, k)]
@@ -98,8 +98,8 @@ def test_bad_inputs():
 
 # ------------------------------------------------------------------ motion situations and the tracker
 
-import trackers  # noqa: E402
-from trackers.jpda import NEW, NORMAL, OCCLUDED, REVIVED, SEPARATED, SPLIT, VANISHED, situations  # noqa: E402
+from mtt_sim import trackers  # noqa: E402
+from mtt_sim.trackers.jpda import NEW, NORMAL, OCCLUDED, REVIVED, SEPARATED, SPLIT, VANISHED, situations  # noqa: E402
 
 
 def test_situations_from_beta_prime():

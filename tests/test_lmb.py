@@ -8,11 +8,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import trackers
+from mtt_sim import trackers
 from helpers import placed, run_tracker, still, tiny
 from mtt_sim.env import TrackingEnv
-from trackers import gaussian_mixture as gm
-from trackers.lmb import group_update
+from mtt_sim.trackers import gaussian_mixture as gm
+from mtt_sim.trackers.lmb import group_update
 
 INFO = {"image_size": (640, 480)}
 
@@ -182,7 +182,7 @@ def test_group_update_through_murty_equals_brute_force_and_enumeration(seed, mon
     log_r = np.log(rng.uniform(0.2, 0.95, n))
     log_q = np.where(rng.random((n, m)) < 0.7, rng.normal(1.0, 1.5, (n, m)), -np.inf)
     enumerated = group_update(log_r, log_q, 0.8, hypotheses=15)
-    monkeypatch.setattr("trackers.lmb.ENUMERATE_UP_TO", 0)
+    monkeypatch.setattr("mtt_sim.trackers.lmb.ENUMERATE_UP_TO", 0)
     np.testing.assert_allclose(group_update(log_r, log_q, 0.8, hypotheses=15), enumerated, atol=1e-12)
     if n == 4:
         np.testing.assert_allclose(group_update(log_r, log_q, 0.8, hypotheses=10**4), brute_force_beta(log_r, log_q, 0.8),

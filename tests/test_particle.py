@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import mtt_sim  # noqa: F401  (registers the env ids)
-import trackers
+from mtt_sim import trackers
 from helpers import leaving_book, run_tracker
-from trackers.particle import systematic_resample
+from mtt_sim.trackers.particle import systematic_resample
 
 
 def episode(spec, steps=200, seed=0):

@@ -3,9 +3,9 @@ known answer, the FIFO pool, and `mtt-sim learn-reid` reproducing the shipped me
 
 import numpy as np
 
-import trackers
+from mtt_sim import trackers
 from mtt_sim import cli
-from trackers import reid
+from mtt_sim.trackers import reid
 
 
 def test_siltp_code_of_a_hand_made_neighbourhood():

@@ -8,8 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import BOOKS_WITH_DECOY
-from mtt_sim import scenario
-from mtt_sim.scenario import ConfigError, load
+from mtt_sim.sim import scenario
+from mtt_sim.sim.config import ConfigError
+from mtt_sim.sim.scenario import load
 
 
 @pytest.mark.parametrize("key", sorted(scenario.available()))

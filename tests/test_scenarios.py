@@ -3,10 +3,13 @@
 import numpy as np
 import pytest
 
-from mtt_sim import TrackingEnv, scene
-from mtt_sim.scenario import ConfigError, load
-from mtt_sim.sensor import CLUTTER
-from mtt_sim.truth import Truth
+from mtt_sim import TrackingEnv
+
+from mtt_sim.real import truth_statistics as scene
+from mtt_sim.sim.config import ConfigError
+from mtt_sim.sim.scenario import load
+from mtt_sim.sim.sensor import CLUTTER
+from mtt_sim.sim.truth import Truth
 
 NO_TRACKS = {"ids": [], "boxes": np.zeros((0, 4))}
 

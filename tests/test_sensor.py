@@ -6,13 +6,13 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from helpers import placed, still, tiny
-from mtt_sim import calibrate
-from mtt_sim import sensor as sensor_mod
-from mtt_sim.scenario import SensorConfig
-from mtt_sim.sensor import CLUTTER, components, detection_probabilities
+from mtt_sim.real import calibrate
+from mtt_sim.sim import sensor as sensor_mod
+from mtt_sim.sim.config import SensorConfig
+from mtt_sim.sim.sensor import CLUTTER, components, detection_probabilities
 from mtt_sim.env import TrackingEnv
 from mtt_sim.metrics import box_iou
-from mtt_sim.truth import Truth
+from mtt_sim.sim.truth import Truth
 
 
 def test_ideal_detector_returns_exactly_the_visible_boxes():

@@ -8,10 +8,12 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mtt_sim
-import trackers
+from mtt_sim import trackers
 from helpers import write_sequence
-from mtt_sim import TrackingEnv, cli, experiment, motchallenge
-from mtt_sim.sequence import Recording
+from mtt_sim import TrackingEnv, cli
+from mtt_sim.lab import experiment
+from mtt_sim.real import motchallenge
+from mtt_sim.real.sequence import Recording
 
 A, B, C, D = (0.0, 0.0, 10.0, 20.0), (30.0, 0.0, 10.0, 20.0), (60.0, 0.0, 10.0, 20.0), (0.0, 40.0, 20.0, 10.0)
 # frame 1: a pedestrian (A), a static person (B, a distractor), a pedestrian marked not to be scored (C), a car (D)

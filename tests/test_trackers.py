@@ -9,11 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import mtt_sim  # noqa: F401
-import trackers
+from mtt_sim import trackers
 from helpers import run_tracker
-from trackers.assignment import assign, corner_iou, lapjv, murty, plus_one_iou
-from trackers.kalman import KalmanBank, box_model, point_model
-from trackers.sort import corners_to_measurement, state_to_corners
+from mtt_sim.trackers.assignment import assign, corner_iou, lapjv, murty, plus_one_iou
+from mtt_sim.trackers.kalman import KalmanBank, box_model, point_model
+from mtt_sim.trackers.sort import corners_to_measurement, state_to_corners
 
 BASELINES = ["sort", "iou", "gnn", "bytetrack"]
 FRAMES = 30

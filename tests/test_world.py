@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 
 from helpers import BOOKS_WITH_DECOY, still, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
-from mtt_sim.scenario import load
-from mtt_sim.world import World, _SpotGrid
+from mtt_sim.sim.scenario import load
+from mtt_sim.sim.world import World, _SpotGrid
 
 
 def world(sc, seed=0):

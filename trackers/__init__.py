@@ -1,6 +1,7 @@
-"""Tracker agents for mtt-sim: pure numpy/scipy/OpenCV, never importing mtt_sim or seeing ground truth.
+"""Tracker agents for mtt-sim, installed as `mtt_sim.trackers` (the top-level name `trackers` is Roboflow's): pure
+numpy/scipy/OpenCV, never importing the simulator (only `mtt_sim.trackers.*`) or seeing ground truth.
 
-    import trackers
+    from mtt_sim import trackers
     trackers.available()                 # names with one-line descriptions
     t = trackers.make("sort", max_age=3) # or trackers.make("sort:max_age=3")
     t.reset(info); tracks = t.update(obs); env.step(tracks.to_action(env.action_space))

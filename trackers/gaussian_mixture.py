@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Param
-from .sweep import near_in_x_and_y
+from .near_pairs import near_in_x_and_y
 
 DIM, MEAS = 8, 4
 # the model parameters the LMB and GM-PHD trackers share; noise values chosen on mot17_like seed 100 (not one

@@ -7,7 +7,7 @@ import numpy as np
 from .appearance import bhattacharyya, histograms, hs_bins
 from .base import Param, Tracker, Tracks, frame_of, register
 from .particle import crop_around, image_size, initial_targets, systematic_resample
-from .sweep import near_in_x_and_y
+from .near_pairs import near_in_x_and_y
 
 
 def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.ndarray:

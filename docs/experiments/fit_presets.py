@@ -14,7 +14,9 @@ from pathlib import Path
 
 from scipy.special import expit, logit
 
-from mtt_sim import calibrate, scenario
+from mtt_sim.real import calibrate
+
+from mtt_sim.sim import scenario
 
 PUBLISHED_AP = {"dpm": 0.61, "frcnn": 0.72, "sdp": 0.81}
 DETECTORS = Path(__file__).resolve().parents[2] / "mtt_sim" / "detectors"

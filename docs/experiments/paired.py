@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtt_sim.experiment import METRICS, mean_ci
+from mtt_sim.lab.experiment import METRICS, mean_ci
 
 PARTS = ("FN", "FP", "IDSW")
 

@@ -11,7 +11,7 @@ import time
 
 import ray
 
-from mtt_sim import experiment
+from mtt_sim.lab import experiment
 
 
 def grid(episodes: int, steps: int, backend: str) -> float:

@@ -9,8 +9,8 @@ Gym agent can use, `RecordVideo` included). Run from the repository root:
 
 from __future__ import annotations
 
-from mtt_sim.docsite import still
-from mtt_sim.experiment import run_episodes
+from mtt_sim.show.docsite import still
+from mtt_sim.lab.experiment import run_episodes
 
 STILLS = [  # (scenario, tracker, file, frame, seed, render scale)
     ("crossing", "jpda", "docs/still_jpda_crossing.jpg", 60, 1, 2),

@@ -36,7 +36,7 @@ from stonesoup.types.state import GaussianState
 from stonesoup.updater.kalman import KalmanUpdater
 
 from mtt_sim.metrics import gospa_of_points
-from trackers import make
+from mtt_sim.trackers import make
 
 TARGETS, SCANS, PD, CLUTTER, HALF_WIDTH, Q, R = 20, 200, 0.9, 5.0, 200.0, 0.05, 1.0
 DENSITY = CLUTTER / (2 * HALF_WIDTH) ** 2

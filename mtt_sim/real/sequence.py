@@ -24,10 +24,10 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from . import scenario as scn
-from .scenario import is_sequence
-from .metrics import EPS, box_iou
-from .truth import Truth, occlusion_visibility
+from mtt_sim.sim import scenario as scn
+from mtt_sim.sim.scenario import is_sequence
+from mtt_sim.metrics import EPS, box_iou
+from mtt_sim.sim.truth import Truth, occlusion_visibility
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20")
 PEDESTRIAN = 1

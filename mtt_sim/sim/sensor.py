@@ -22,9 +22,9 @@ import cv2
 import numpy as np
 from scipy.special import expit, logit
 
-from .metrics import rows_of
-from .scenario import Scenario, SensorConfig
-from .truth import Truth, clip_boxes, overlapping_pairs
+from mtt_sim.metrics import rows_of
+from mtt_sim.sim.config import Scenario, SensorConfig
+from mtt_sim.sim.truth import Truth, clip_boxes, overlapping_pairs
 
 CLUTTER = -1   # source of a false detection
 UNKNOWN = 0    # source of a foreground blob (the image does not say which target made it)

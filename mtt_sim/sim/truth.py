@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .render import draw_fixed, fixed_point
+from mtt_sim.sim.render import draw_fixed, fixed_point
 
 
 @dataclass(frozen=True)

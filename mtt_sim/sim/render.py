@@ -14,8 +14,8 @@ from functools import cached_property
 import cv2
 import numpy as np
 
-from .scenario import TEXTURES, Scenario
-from .world import World
+from mtt_sim.sim.config import TEXTURES, Scenario
+from mtt_sim.sim.world import World
 
 SHIFT = 4
 _ONE = 1 << SHIFT

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from trackers import reid
+from mtt_sim.trackers import reid
 
-from .env import NO_TRACKS, TrackingEnv
+from mtt_sim.env import NO_TRACKS, TrackingEnv
 
 def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility: float = 0.9,
                    min_height: float = 24.0, progress: bool = False) -> tuple[np.ndarray, np.ndarray]:

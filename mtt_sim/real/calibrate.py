@@ -32,12 +32,12 @@ import numpy as np
 from scipy.optimize import brentq, least_squares, linear_sum_assignment, minimize
 from scipy.special import expit, logit, logsumexp
 
-from . import scenario as scn
-from . import scene
-from .metrics import box_iou
-from .sensor import SyntheticSensor
-from .sequence import Recording
-from .truth import Truth, overlapping_pairs
+from mtt_sim.sim import scenario as scn
+from mtt_sim.real import truth_statistics as scene
+from mtt_sim.metrics import box_iou
+from mtt_sim.sim.sensor import SyntheticSensor
+from mtt_sim.real.sequence import Recording
+from mtt_sim.sim.truth import Truth, overlapping_pairs
 
 MATCH_IOU = 0.5     # a true detection
 OUTLIER_IOU = 0.3   # a detection of the person with a poor box

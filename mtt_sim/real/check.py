@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .experiment import run_episode
-from .motchallenge import evaluate_results
-from .sequence import read_rows
+from mtt_sim.lab.experiment import run_episode
+from mtt_sim.real.motchallenge import evaluate_results
+from mtt_sim.real.sequence import read_rows
 
 TOLERANCE = 5e-7 + 1e-9  # the reference files' 6 decimals
 # MOTA (%), FP, FN, IDSW of the reference outputs under TrackEval: the SORT README's "Main Results" for TUD-Campus,

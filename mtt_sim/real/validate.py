@@ -18,7 +18,9 @@ from typing import Sequence
 import numpy as np
 from scipy.stats import kendalltau
 
-from . import calibrate, experiment
+from mtt_sim.real import calibrate
+
+from mtt_sim.lab import experiment
 
 TRACKERS = ("sort", "iou", "bytetrack", "gnn", "gmphd", "lmb:reid=false", "jpda")
 METRICS = ("MOTA", "IDF1", "IDSW")

@@ -19,12 +19,13 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-import trackers
+from mtt_sim import trackers
 
-from . import env as env_module
-from . import experiment, scenario
-from .env import NO_TRACKS, TrackingEnv
-from .metrics import EpisodeMetrics, box_iou
+from mtt_sim import env as env_module
+from mtt_sim.lab import experiment
+from mtt_sim.sim import scenario
+from mtt_sim.env import NO_TRACKS, TrackingEnv
+from mtt_sim.metrics import EpisodeMetrics, box_iou
 
 SIZE = (640, 480)
 

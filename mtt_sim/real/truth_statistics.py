@@ -7,7 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .truth import Truth
+from mtt_sim.sim.truth import Truth
 
 LAG = 5            # frames over which a heading is measured
 MIN_MOVE = 0.1     # a heading counts where the feet moved at least this share of the box height over LAG frames
@@ -15,7 +15,7 @@ MIN_MOVE = 0.1     # a heading counts where the feet moved at least this share o
 
 def record(scenario: str, config: dict | None = None, seed: int = 0, steps: int | None = None):
     """One episode without a tracker: each frame's truth and detections (x, y, w, h, confidence)."""
-    from .env import NO_TRACKS, TrackingEnv  # here: the env module is heavy, and only this needs it
+    from mtt_sim.env import NO_TRACKS, TrackingEnv  # here: the env module is heavy, and only this needs it
 
     env = TrackingEnv(scenario, config=config, obs_mode="detections")
     obs, _ = env.reset(seed=seed)

@@ -20,10 +20,10 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from .env import NO_TRACKS, TrackingEnv
-from .metrics import EpisodeMetrics
-from .scenario import is_sequence
-from .sequence import Recording, by_frame, check_frames, read_rows
+from mtt_sim.env import NO_TRACKS, TrackingEnv
+from mtt_sim.metrics import EpisodeMetrics
+from mtt_sim.sim.scenario import is_sequence
+from mtt_sim.real.sequence import Recording, by_frame, check_frames, read_rows
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
            config: Mapping | None = None, progress: bool = False) -> dict:

@@ -9,7 +9,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .experiment import summarize
+from mtt_sim.lab.experiment import summarize
 
 # The values each metric can take (an interval reaching past them says nothing): ratios in [0, 1], MOTA and MODA
 # at most 1, everything else (counts, distances, GOSPA) at least 0.

@@ -20,7 +20,7 @@ import numpy as np
 import pymunk
 import pymunk.batch as pbatch
 
-from .scenario import MOTIONS, TEXTURES, Scenario
+from mtt_sim.sim.config import MOTIONS, TEXTURES, Scenario
 
 WALL_BIT = 1 << 31
 _FREE, _FOR_GOOD, _LEFT = 0, -1, -2  # carry_left beside the frames left to ride: free, a carried group's, just left

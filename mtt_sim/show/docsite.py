@@ -15,12 +15,14 @@ from pathlib import Path
 import cv2
 import gymnasium as gym
 
-import trackers
+from mtt_sim import trackers
 
-from . import env_ids, scenario
-from .experiment import run_episodes
+from mtt_sim import env_ids
 
-ROOT = Path(__file__).resolve().parent.parent
+from mtt_sim.sim import scenario
+from mtt_sim.lab.experiment import run_episodes
+
+ROOT = Path(__file__).resolve().parents[2]  # the source checkout
 GIF_FRAMES = 40
 # The trackers each scenario was made for (the papers' scenes) or suits best, the first drawn in its still.
 SUITS = {"crossing": ("jpda", "gnn"), "soccer": ("jpda", "gnn"), "umbrellas": ("pf",), "books": ("ipf", "pcpf"),

@@ -8,8 +8,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .truth import Truth
-from .world import hue_colors
+from mtt_sim.sim.truth import Truth
+from mtt_sim.sim.world import hue_colors
 
 GT_COLOR = (40, 220, 40)
 DET_COLOR = (250, 220, 0)

@@ -17,7 +17,9 @@ import sys
 import tomllib
 from pathlib import Path
 
-from . import __version__, scenario
+from mtt_sim import __version__
+
+from mtt_sim.sim import scenario
 
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
                 "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
@@ -105,7 +107,7 @@ def _scenarios(text: str) -> list[str]:
 
 
 def _tracker_specs(text: str) -> list[str]:
-    import trackers
+    from mtt_sim import trackers
 
     specs = trackers.split_specs(text)
     if not specs or len(set(specs)) != len(specs):
@@ -139,7 +141,7 @@ def _calibration_folder(text: str) -> str:
 
 
 def _metrics(text: str) -> list[str]:
-    from .metrics import METRICS, PER_TARGET
+    from mtt_sim.metrics import METRICS, PER_TARGET
 
     names = {m.lower(): m for m in (*METRICS, *PER_TARGET)}
     out = []
@@ -240,7 +242,7 @@ def cmd_run(args) -> int:
     if args.compare and args.results:
         raise UsageError("--results", "a results file takes one tracker: leave out --compare")
     specs = args.compare or [args.tracker]
-    from . import experiment
+    from mtt_sim.lab import experiment
 
     records = experiment.run_episodes(args.scenario, specs, args.seed, overrides, video=args.video, steps=args.steps,
                                       progress=True, scale=args.scale, results=args.results)
@@ -262,7 +264,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .metrics import PER_TARGET
+    from mtt_sim.metrics import PER_TARGET
 
     overrides = _overrides(args)
     _loaded(args.scenarios, overrides)
@@ -274,7 +276,7 @@ def cmd_bench(args) -> int:
         raise UsageError("--plot", "plots columns of scenarios: leave out --by target")
 
     def plot(records):
-        from . import plots
+        from mtt_sim.lab import plots
 
         plots.bench_plot(records, args.metric, args.plot)
     return _grid(args, args.scenarios, overrides, None, lambda records, metric: _table(records, metric, args.by, title),
@@ -292,7 +294,7 @@ def cmd_sweep(args) -> int:
     _plot_output(args)
 
     def table(records, metric) -> str:
-        from . import experiment
+        from mtt_sim.lab import experiment
 
         rows = experiment.summarize(records, metric, by="config")
         for r in rows:
@@ -300,7 +302,7 @@ def cmd_sweep(args) -> int:
         return experiment.markdown(rows, f"{args.scenario}, sweeping {key}") if rows else ""
 
     def plot(records):
-        from . import plots
+        from mtt_sim.lab import plots
 
         plots.sweep_plot(records, args.scenario, key, values, args.metric, args.plot)
     return _grid(args, [args.scenario], overrides, [{key: v} for v in values], table, plot)
@@ -314,7 +316,7 @@ def _plot_output(args) -> None:
 
 
 def _table(records, metric, by, title) -> str:
-    from . import experiment
+    from mtt_sim.lab import experiment
 
     rows = experiment.summarize(records, metric, by=by)
     return experiment.markdown(rows, title) if rows else ""
@@ -332,7 +334,7 @@ def _grid(args, scenarios: list[str], overrides: dict, configs, table, plot) -> 
         _writable_folder(folder if folder.is_dir() else folder.parent, "--results-dir", args.results_dir)
     if args.backend == "ray":
         _require("ray", "--backend", "ray")
-    from . import experiment
+    from mtt_sim.lab import experiment
 
     finished = []
     record_file = experiment.RecordFile(out) if out else None
@@ -384,7 +386,7 @@ def _grid_size(args, scenarios, configs) -> int:
 
 
 def cmd_list(args) -> int:
-    from . import env_ids
+    from mtt_sim import env_ids
 
     ids = env_ids()
     for key, desc in scenario.available().items():
@@ -395,7 +397,7 @@ def cmd_list(args) -> int:
 
 
 def cmd_trackers(args) -> int:
-    import trackers
+    from mtt_sim import trackers
 
     for name, cls in sorted(trackers.base.REGISTRY.items()):
         print(f"{name}: {cls.description}")
@@ -407,7 +409,7 @@ def cmd_trackers(args) -> int:
 def cmd_perf(args) -> int:
     from tqdm import tqdm
 
-    from . import perf
+    from mtt_sim.lab import perf
 
     sections = [("env", lambda: perf.report(perf.measure(repeats=args.repeats, steps=args.steps))),
                 ("scenarios", lambda: perf.report_scenarios(perf.measure_scenarios(repeats=args.repeats, steps=args.steps))),
@@ -427,11 +429,11 @@ def cmd_perf(args) -> int:
 
 
 def cmd_learn_reid(args) -> int:
-    import trackers.reid
+    from mtt_sim.trackers import reid
 
-    out = trackers.reid.METRIC_FILE if args.install else Path(args.out)
+    out = reid.METRIC_FILE if args.install else Path(args.out)
     _output(str(out), args.force or args.install, "--out", (".npz",))
-    from . import learn_reid
+    from mtt_sim.lab import learn_reid
 
     summary = learn_reid.learn(out, args.scenario, args.seeds, args.frames, args.every, args.dims, progress=True)
     for k, v in summary.items():
@@ -448,7 +450,7 @@ def cmd_export(args) -> int:
     if out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
         raise UsageError("--out", f"{args.out!r} exists and is not empty; add --force to replace its sequence")
     _writable_folder(out if out.is_dir() else out.parent, "--out", args.out)
-    from . import motchallenge
+    from mtt_sim.real import motchallenge
 
     summary = motchallenge.export(args.scenario, out, args.seed, args.steps, overrides, progress=True)
     for k, v in summary.items():
@@ -465,7 +467,7 @@ def cmd_docs(args) -> int:
     _require("material", "docs", "docs")
     import tempfile
 
-    from . import docsite
+    from mtt_sim.show import docsite
 
     with tempfile.TemporaryDirectory() as work:
         docsite.build(out, Path(work))
@@ -478,7 +480,7 @@ def cmd_eval(args) -> int:
                                  ("--results", Path(args.results), "a results file")):
         if not path.is_file():
             raise UsageError(argument, f"{str(path)!r} not found; expected {kind}")
-    from . import motchallenge
+    from mtt_sim.real import motchallenge
 
     s = scenario.ScoringConfig()
     metrics = motchallenge.evaluate_results(args.gt, args.results, benchmark=args.benchmark, similarity=args.similarity,
@@ -501,14 +503,14 @@ def _print_summary(summary: dict) -> None:
 def cmd_check_real(args) -> int:
     if not (Path(args.data) / "mot15").is_dir():
         raise UsageError("data", f"{args.data!r}: expected the shared data folder (with mot15/, reference/, mot17/)")
-    from . import check_real
+    from mtt_sim.real import check as check_real
 
     return 0 if check_real.check(args.data) else 1
 
 
 def cmd_calibrate(args) -> int:
     out = _output(args.out, args.force, "--out", (".toml",))
-    from . import calibrate
+    from mtt_sim.real import calibrate
 
     fitted = calibrate.calibrate(args.folders, seeds=args.seeds)
     print(calibrate.report(fitted))
@@ -520,7 +522,7 @@ def cmd_calibrate(args) -> int:
 
 def cmd_validate(args) -> int:
     out = _output(args.out, args.force, "--out", (".md",))
-    from . import validate
+    from mtt_sim.real import validate
 
     result = validate.validate(args.folders, args.trackers or validate.TRACKERS, seeds=args.seeds, workers=args.workers, progress=True)
     text = validate.markdown(result)
@@ -718,6 +720,3 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         signal.signal(signal.SIGTERM, previous)
 
-
-if __name__ == "__main__":
-    sys.exit(main())

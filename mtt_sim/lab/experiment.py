@@ -22,13 +22,13 @@ import numpy as np
 from scipy.special import stdtrit
 from tqdm import tqdm
 
-import trackers
+from mtt_sim import trackers
 
-from . import pool
-from .env import TrackingEnv
-from .metrics import METRICS, PER_TARGET
-from .motchallenge import write_results
-from .overlay import VideoWriter
+from mtt_sim.lab import pool
+from mtt_sim.env import TrackingEnv
+from mtt_sim.metrics import METRICS, PER_TARGET
+from mtt_sim.real.motchallenge import write_results
+from mtt_sim.show.overlay import VideoWriter
 
 BACKENDS = ("local", "ray")
 

@@ -1,0 +1,1 @@
+"""Real data: MOTChallenge sequences and files, the detector's calibration, the sim-to-real validation."""

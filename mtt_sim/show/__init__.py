@@ -1,0 +1,1 @@
+"""Pictures: overlays on frames, videos, the live viewer and the documentation site."""

@@ -1,0 +1,275 @@
+"""The scenario's schema: typed, frozen dataclasses, one per TOML table, and the detector presets.
+
+Every field is a `setting`: its meaning, unit and allowed values live in its ``metadata``, which the validator in
+`mtt_sim.sim.scenario` checks and `reference_table` turns into the configuration reference.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from typing import Any
+
+
+
+class ConfigError(ValueError):
+    """A scenario file or override is invalid; the message names file, key, value and what is allowed."""
+
+
+def setting(default, doc, unit="", lo=None, hi=None, choices=None):
+    """A dataclass field whose metadata documents and constrains it."""
+    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "choices": choices}
+    if isinstance(default, (list, tuple)) and default and dataclasses.is_dataclass(default[0]):
+        return field(default_factory=lambda: tuple(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+def table(cls, doc):
+    """A nested dataclass field (a TOML table)."""
+    return field(default_factory=cls, metadata={"doc": doc})
+
+
+Color = tuple[int, int, int]
+Rect = tuple[float, float, float, float]
+
+MOTIONS = ("cv", "random_walk", "manoeuvre", "goal", "carried")
+TEXTURES = ("none", "stripes", "checks", "noise")
+
+
+@dataclass(frozen=True)
+class GroupConfig:
+    """One kind of target: its look, its motion model and how many there are."""
+
+    name: str = setting("targets", "group name (other groups refer to it, e.g. as carrier)")
+    count: int = setting(4, "targets placed at reset", "targets", 0, 10000)
+    birth_rate: float = setting(0.0, "Poisson births per frame at the world borders, entering inward", "1/frame", 0.0, 100.0)
+    region: Rect = setting((0.0, 0.0, 1.0, 1.0), "where initial targets are placed: x0, y0, x1, y1 as fractions of the world", "fraction", 0.0, 1.0)
+    shape: str = setting("ellipse", "drawn outline; the physics footprint is a circle (ellipse) or a box (rect)", choices=("ellipse", "rect"))
+    size: tuple[float, float] = setting((24.0, 24.0), "drawn width, height (standing: at the near edge of the image)", "px", 1.0, 2000.0)
+    size_jitter: float = setting(0.1, "relative standard deviation of each target's size", "", 0.0, 0.5)
+    color: Color = setting((200, 60, 60), "base colour, RGB", "", 0, 255)
+    similarity: float = setting(0.0, "0: every target gets a distinct random hue; 1: all share `color` exactly", "", 0.0, 1.0)
+    texture: str = setting("none", "pattern drawn on the target so gradient features exist", choices=TEXTURES)
+    gait: float = setting(0.0, "non-rigid deformation: relative amplitude of the periodic change of the axes", "", 0.0, 0.5)
+    gait_period: float = setting(20.0, "period of the gait", "frames", 2.0, 1000.0)
+    motion: str = setting("cv", "motion model: constant velocity with random acceleration, Brownian random walk, "
+                       "manoeuvres (sudden turns and stops), goal-seeking toward an exit, carried by another target",
+                       choices=MOTIONS)
+    speed: float = setting(2.0, "mean initial speed (random_walk: velocity standard deviation per frame)", "px/frame", 0.0, 200.0)
+    speed_jitter: float = setting(0.2, "relative standard deviation of the initial speed", "", 0.0, 1.0)
+    heading: float = setting(0.0, "mean initial direction of travel, 0 = +x (right), 90 = +y (down)", "deg", -360.0, 360.0)
+    heading_jitter: float = setting(180.0, "half-width of the uniform spread around `heading`; 180 = any direction", "deg", 0.0, 180.0)
+    accel: float = setting(0.05, "standard deviation of the random acceleration (cv, manoeuvre, goal)", "px/frame^2", 0.0, 50.0)
+    max_speed: float = setting(20.0, "speeds are clipped to this", "px/frame", 0.1, 500.0)
+    turn_prob: float = setting(0.02, "manoeuvre: probability per frame of a sudden turn by 60..180 deg", "1/frame", 0.0, 1.0)
+    stop_prob: float = setting(0.01, "manoeuvre: probability per frame of stopping, and of a stopped target starting again x5", "1/frame", 0.0, 1.0)
+    layer: int = setting(0, "topdown: targets on different layers do not collide; higher layers are drawn on top", "", 0, 15)
+    carrier: str = setting("", "carried: name of the group whose targets carry these (one each, pinned by a joint)")
+
+
+@dataclass(frozen=True)
+class DoorConfig:
+    """A place inside the scene where targets appear (entry) or disappear (exit)."""
+
+    rect: Rect = setting((0.0, 0.0, 10.0, 10.0), "x, y, w, h in world coordinates", "px", -1e5, 1e5)
+    role: str = setting("both", "entry: spawns targets; exit: absorbs goal-seeking and passing targets; both", choices=("entry", "exit", "both"))
+    birth_rate: float = setting(0.0, "Poisson births per frame from this door", "1/frame", 0.0, 100.0)
+    group: str = setting("", "group of the targets it spawns (default: the first group)")
+
+
+@dataclass(frozen=True)
+class OccluderConfig:
+    """A static object (pillar, tree, wall) drawn in front of the targets behind it."""
+
+    rect: Rect = setting((0.0, 0.0, 10.0, 10.0), "x, y, w, h in world coordinates", "px", -1e5, 1e5)
+    shape: str = setting("rect", "drawn outline", choices=("rect", "ellipse"))
+    color: Color = setting((90, 90, 90), "RGB", "", 0, 255)
+    solid: bool = setting(False, "targets collide with it (topdown: its area; standing: its base line)")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """The pymunk world: its size, projection, walls, collisions and population limits."""
+
+    projection: str = setting("topdown", "topdown: the image is the world plane; standing: the world is the ground plane "
+                           "and targets are upright blobs that shrink with distance", choices=("topdown", "standing"))
+    size: tuple[float, float] = setting((0.0, 0.0), "world width, height; 0 = the image size (larger for a panning camera)", "px", 0.0, 1e5)
+    walls: bool = setting(False, "targets bounce off the world borders instead of leaving")
+    collision: str = setting("elastic", "target-target contacts: elastic, soft (inelastic) or none", choices=("elastic", "soft", "none"))
+    max_alive: int = setting(1000, "no births while this many targets are alive (at most the label map's 65535)", "targets", 1,
+                          65535)
+    max_births: int = setting(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
+    far_scale: float = setting(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
+    carry_frames: int = setting(0, "topdown: a target completely covered by a moving target of a higher layer rides with it "
+                                "for this many frames and is then left where it is (seed 002's Fig. 14); 0 = never",
+                             "frames", 0, 100000)
+
+
+@dataclass(frozen=True)
+class RenderConfig:
+    """How a frame looks: resolution, background, lighting, noise and camera."""
+
+    width: int = setting(640, "image width", "px", 16, 4096)
+    height: int = setting(480, "image height", "px", 16, 4096)
+    background: str = setting("noise", "flat colour, textured noise, or clutter of target-like blobs", choices=("flat", "noise", "clutter"))
+    background_color: Color = setting((110, 120, 110), "RGB", "", 0, 255)
+    background_blobs: int = setting(40, "clutter background: number of static blobs", "", 0, 10000)
+    brightness: float = setting(1.0, "global gain; below 1 is a dark scene", "", 0.05, 3.0)
+    illumination_drift: float = setting(0.0, "relative amplitude of a slow sinusoidal gain drift", "", 0.0, 0.9)
+    illumination_period: float = setting(200.0, "period of the drift", "frames", 2.0, 1e6)
+    flicker: float = setting(0.0, "standard deviation of a per-frame relative gain jitter", "", 0.0, 0.5)
+    noise: float = setting(0.0, "Gaussian pixel noise standard deviation", "grey levels", 0.0, 100.0)
+    blur: float = setting(0.0, "Gaussian blur sigma (0 = none)", "px", 0.0, 20.0)
+    camera: str = setting("static", "static; pan: sweeps across a larger world; follow: keeps the targets' mean centred; "
+                       "shake: handheld jitter", choices=("static", "pan", "follow", "shake"))
+    pan_speed: tuple[float, float] = setting((2.0, 0.0), "pan: camera velocity, reversing at the world's edges; follow: its "
+                                          "largest speed", "px/frame", -100.0, 100.0)
+    shake: float = setting(3.0, "shake: standard deviation of the camera offset", "px", 0.0, 100.0)
+
+
+def _fitted_detectors() -> dict[str, dict[str, Any]]:
+    """The fitted detectors shipped as mtt_sim/sim/detectors/<name>.toml, each a [sensor] table whose header says what it
+    is fitted to; `model` and `memory` stay the scenario's own."""
+    out = {}
+    for entry in sorted(resources.files("mtt_sim.sim").joinpath("detectors").iterdir(), key=lambda p: p.name):
+        if entry.name.endswith(".toml"):
+            table = tomllib.loads(entry.read_text())["sensor"]
+            out[entry.name[:-5]] = {k: v for k, v in table.items() if k not in ("model", "memory")}
+    return out
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "ideal": dict(pd=1.0, min_visibility=0.0, box_noise=0.0, box_size_noise=0.0, box_drift=0.0, box_outlier_prob=0.0,
+                  box_outlier_persist=0.0, box_scale=1.0, fragment_prob=0.0, merge_prob=0.0, clutter_rate=0.0,
+                  site_rate=0.0, conf_true=0.95, conf_false=0.3),
+    **_fitted_detectors(),
+}
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """The simulated detector. Keys given explicitly override the chosen preset's values.
+
+    `synthetic` detects a target with a probability logistic in its visible fraction and height, raised after a
+    detection and lowered after a miss (`miss_corr`); boxes carry per-frame noise, occasional outliers and a per-target
+    drift; false positives are fresh clutter plus persistent sites; confidences are Beta-distributed by source.
+    """
+
+    model: str = setting("synthetic", "synthetic: from the truth and the label map; foreground: background subtraction on "
+                      "the frame; recorded: a sequence folder's det/det.txt (its default; synthetic replays its ground "
+                      "truth through the synthetic detector instead)", choices=("synthetic", "foreground", "recorded"))
+    preset: str = setting("", "fill the keys below from a detector preset (docs/detectors.md: what each is fitted to)",
+                       choices=("",) + tuple(PRESETS))
+    memory: bool = setting(True, "errors persist: misses follow each target's last outcome, boxes drift, false-positive "
+                        "sites last site_life frames; false: every frame drawn independently with the same rates")
+    pd: float = setting(0.95, "P(detect) of a fully visible target at least reference_height tall (its recall over time)", "",
+                     0.0, 1.0)
+    miss_corr: float = setting(0.5, "frame-to-frame correlation of a target's misses: P(detect) is P + (1 - P) miss_corr "
+                            "after a detection and P (1 - miss_corr) after a miss", "", 0.0, 0.999)
+    pd_spread: float = setting(0.0, "spread of each target's own ease of detection, drawn once: N(0, pd_spread) on the "
+                            "logit of P(detect) (some people are found in almost every frame, some hardly ever)",
+                            "logit", 0.0, 10.0)
+    visibility_slope: float = setting(4.0, "logit of P(detect) gained per unit of visible fraction", "logit", 0.0, 100.0)
+    height_slope: float = setting(0.0, "logit of P(detect) lost per halving of the box height below reference_height",
+                               "logit", -10.0, 10.0)
+    reference_height: float = setting(100.0, "box height from which pd holds (taller is no easier)", "px", 1.0, 1e4)
+    min_visibility: float = setting(0.2, "never detected at or below this visible fraction", "", 0.0, 1.0)
+    box_noise: float = setting(0.03, "per-frame noise of the box centre, across and down, in units of the box's scale "
+                            "sqrt(w h) (standard deviation)", "", 0.0, 1.0)
+    box_size_noise: float = setting(0.03, "per-frame noise of the box width and height, in units of sqrt(w h)", "",
+                                 0.0, 1.0)
+    box_drift: float = setting(0.0, "per-target drift of the box centre, AR(1) with this stationary standard deviation "
+                            "(units of sqrt(w h)), on top of the per-frame noise", "", 0.0, 1.0)
+    box_size_drift: float = setting(0.0, "the same for the box width and height", "", 0.0, 1.0)
+    box_drift_corr: float = setting(0.9, "frame-to-frame correlation of the box drift", "", 0.0, 0.999)
+    box_outlier_prob: float = setting(0.0, "probability a detection's box is an outlier (IoU 0.3-0.5 with its target's) "
+                                   "when the target's last box was good", "", 0.0, 1.0)
+    box_outlier_persist: float = setting(0.0, "the same when its last box was an outlier, or it was missed or new (poor "
+                                      "boxes persist, and a target coming back is often boxed poorly)", "", 0.0, 1.0)
+    box_outlier_noise: float = setting(0.3, "spread of outlier boxes and of sites held beside a target (units of "
+                                    "sqrt(w h))", "", 0.01, 2.0)
+    box_scale: float = setting(1.0, "systematic box enlargement (loose boxes > 1)", "", 0.5, 2.0)
+    box_aspect: float = setting(1.0, "systematic widening relative to the height (> 1: boxes too wide)", "", 0.25, 4.0)
+    fragment_prob: float = setting(0.02, "probability a visible target is reported as 2-3 fragments "
+                                "(always when an occluder cuts it apart)", "", 0.0, 1.0)
+    merge_prob: float = setting(0.5, "probability targets whose visible regions touch are reported as one box", "", 0.0, 1.0)
+    clutter_rate: float = setting(0.5, "Poisson mean of fresh false detections per frame (each lasts one frame)", "1/frame",
+                               0.0, 1000.0)
+    site_rate: float = setting(0.0, "Poisson mean of persistent false-alarm sites born per frame", "1/frame", 0.0, 100.0)
+    site_life: float = setting(10.0, "mean life of a site (geometric; it fires every frame it lives)", "frames", 1.0, 1e5)
+    site_near: float = setting(0.5, "share of sites born beside a visible target (IoU 0.1-0.3 with it), moving with it "
+                            "(double and partial boxes); the rest are static background boxes", "", 0.0, 1.0)
+    conf_true: float = setting(0.85, "mean confidence of a detection of a fully visible target at least reference_height tall",
+                            "", 0.01, 0.99)
+    conf_visibility: float = setting(2.0, "logit of the mean true confidence gained per unit of visible fraction",
+                                  "logit", 0.0, 100.0)
+    conf_height: float = setting(0.0, "logit of the mean true confidence lost per halving of the box height below "
+                              "reference_height", "logit", -10.0, 10.0)
+    conf_false: float = setting(0.35, "mean confidence of a false detection", "", 0.01, 0.99)
+    conf_spread: float = setting(8.0, "Beta concentration of the true confidences (higher = tighter)", "", 0.5, 1e4)
+    conf_false_spread: float = setting(0.0, "Beta concentration of the false confidences (0 = conf_spread)", "", 0.0, 1e4)
+    conf_offset: float = setting(0.0, "reported confidence = conf_offset + conf_scale * Beta draw (raw scores like DPM's)",
+                              "", -1e4, 1e4)
+    conf_scale: float = setting(1.0, "see conf_offset", "", 1e-6, 1e4)
+    min_area: float = setting(20.0, "foreground: smallest blob kept", "px^2", 0.0, 1e6)
+    threshold: float = setting(25.0, "foreground: grey-level difference that counts as foreground", "grey levels", 1.0, 255.0)
+    learning_rate: float = setting(0.02, "foreground: background model update rate on background pixels", "", 0.0, 1.0)
+    max_detections: int = setting(256, "observation rows; extra detections (lowest confidence first) are dropped", "", 1, 100000)
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """The Gym face: episode length, action size and what the observation holds."""
+
+    max_steps: int = setting(300, "episode length; truncated after this many steps", "steps", 1, 10**7)
+    max_tracks: int = setting(256, "rows of the action's padded track arrays", "", 1, 100000)
+    obs_mode: str = setting("frame+detections", "detections: no frame in the observation (no rendering cost beyond the label map)",
+                         choices=("frame+detections", "detections"))
+
+
+@dataclass(frozen=True)
+class ScoringConfig:
+    """How tracks are scored against ground truth: the matching, the GOSPA parameters and the per-step reward."""
+
+    similarity: str = setting("iou", "iou: box overlap; centroid: max(0, 1 - centre distance / zero_distance)",
+                           choices=("iou", "centroid"))
+    threshold: float = setting(0.5, "a track matches a target when their similarity is at least this (CLEAR, IDF1)", "", 0.01, 1.0)
+    zero_distance: float = setting(20.0, "centroid similarity reaches 0 at this centre distance", "px", 0.1, 1e5)
+    gospa_c: float = setting(50.0, "GOSPA cut-off distance (a miss or a false track costs c/2)", "px", 0.1, 1e5)
+    gospa_p: float = setting(1.0, "GOSPA order", "", 1.0, 10.0)
+    min_visibility: float = setting(0.0, "targets less visible than this are not scored (0 = every target in the image)", "", 0.0, 1.0)
+    reward_mode: str = setting("mota", "mota: TP - FP - IDSW (return / GT boxes = MOTA); gospa: -GOSPA of the frame; "
+                            "iou: iou_weight * summed IoU of matches - fp_weight * FP - fn_weight * FN",
+                            choices=("mota", "gospa", "iou"))
+    iou_weight: float = setting(1.0, "reward_mode iou: weight of the matched similarity", "", 0.0, 1e3)
+    fp_weight: float = setting(1.0, "reward_mode iou: cost of a false track", "", 0.0, 1e3)
+    fn_weight: float = setting(1.0, "reward_mode iou: cost of a missed target", "", 0.0, 1e3)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A named scenario: everything needed to build and run one episode."""
+
+    name: str = setting("Custom", "CamelCase name; the env id is mtt_sim/<name>-v0")
+    description: str = setting("", "one paragraph: what it models and which experiment it mirrors")
+    world: WorldConfig = table(WorldConfig, "the pymunk world")
+    render: RenderConfig = table(RenderConfig, "the frame")
+    sensor: SensorConfig = table(SensorConfig, "the detector")
+    env: EnvConfig = table(EnvConfig, "the Gym face")
+    scoring: ScoringConfig = table(ScoringConfig, "scoring and rewards")
+    groups: tuple[GroupConfig, ...] = setting((GroupConfig(),), "target groups ([[groups]] tables)")
+    doors: tuple[DoorConfig, ...] = setting((), "entry/exit doors ([[doors]] tables)")
+    occluders: tuple[OccluderConfig, ...] = setting((), "static occluders ([[occluders]] tables)")
+
+    @property
+    def world_size(self) -> tuple[float, float]:
+        """World width and height in pixels (the image size where `world.size` is 0)."""
+        w, h = self.world.size
+        return (w or float(self.render.width), h or float(self.render.height))
+
+    def group(self, name: str) -> int:
+        """Index of the group called `name`."""
+        names = [g.name for g in self.groups]
+        return names.index(name)

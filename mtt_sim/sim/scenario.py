@@ -1,0 +1,423 @@
+"""Scenarios: a nested mapping (TOML file, shipped key, overrides) validated into a frozen `Scenario`.
+
+One generic validator walks the dataclasses of `mtt_sim.sim.config` and rejects unknown keys, wrong types and
+out-of-range values with a message naming the source, the dotted key, the value and what is allowed. The same
+metadata generates the configuration reference (`reference_table`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import functools
+import math
+import tomllib
+import typing
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from mtt_sim.sim.config import (PRESETS, ConfigError, DoorConfig, EnvConfig, GroupConfig, OccluderConfig, RenderConfig,
+                                Scenario, ScoringConfig, SensorConfig, WorldConfig)
+
+# ---------------------------------------------------------------- building from mappings
+
+def _type_name(tp) -> str:
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(value, tp, key: str, meta: Mapping, where: str):
+    """Check `value` against annotation `tp` and the field's range/choices; return the typed value."""
+
+    given = value
+
+    def fail(allowed: str):
+        raise ConfigError(f"{where}: {key} = {given!r}: {allowed}")
+
+    if isinstance(value, (np.generic, np.ndarray)):  # numpy numbers and arrays are numbers and lists
+        value = value.tolist()
+    origin = typing.get_origin(tp)
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, Mapping):
+            fail(f"expected a table of {tp.__name__} keys")
+        return _build(tp, value, where, key + ".")
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            fail(f"expected a list ({_describe(tp)})")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(v, args[0], f"{key}.{i}", meta, where) for i, v in enumerate(value))
+        if len(value) != len(args):
+            fail(f"expected {len(args)} values ({_describe(tp)})")
+        return tuple(_convert(v, a, f"{key}.{i}", meta, where) for i, (v, a) in enumerate(zip(value, args)))
+    if tp is bool:
+        if not isinstance(value, bool):
+            fail("expected true or false")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            fail("expected an integer" + _range_text(meta))
+    elif tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_as_float(value)):
+            fail("expected a finite number" + _range_text(meta))
+        value = float(value)
+    elif tp is str:
+        if not isinstance(value, str):
+            fail("expected a string")
+    if meta.get("choices") is not None and value not in meta["choices"]:
+        fail(f"allowed values: {', '.join(repr(c) for c in meta['choices'])}")
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        fail("out of range" + _range_text(meta))
+    return value
+
+
+def _as_float(value: int | float) -> float:
+    """float(value), with an integer too large for a float read as infinite (so it fails as not finite)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
+
+
+def _range_text(meta: Mapping) -> str:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if lo is None and hi is None:
+        return ""
+    return f"; allowed: {'-inf' if lo is None else lo} <= value <= {'inf' if hi is None else hi}"
+
+
+def _describe(tp) -> str:
+    if typing.get_origin(tp) is tuple:
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return f"list of {_describe(args[0])}"
+        return f"{len(args)} x {_type_name(args[0])}"
+    return _type_name(tp)
+
+
+_HINTS: dict[type, dict[str, Any]] = {}
+
+
+def _hints(cls) -> dict[str, Any]:
+    if cls not in _HINTS:
+        _HINTS[cls] = typing.get_type_hints(cls)
+    return _HINTS[cls]
+
+
+def _build(cls, raw: Mapping, where: str, prefix: str = ""):
+    """Construct dataclass `cls` from mapping `raw`, validating every key."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(raw) - set(fields), key=str)
+    if unknown:
+        near = difflib.get_close_matches(str(unknown[0]), fields, n=1)
+        raise ConfigError(f"{where}: unknown key {prefix}{unknown[0]}" + (f" (did you mean {prefix}{near[0]}?)" if near
+                          else "") + f"; allowed keys: {', '.join(fields)}")
+    hints = _hints(cls)
+    values = {name: _convert(raw[name], hints[name], prefix + name, fields[name].metadata, where)
+              for name in fields if name in raw}
+    return cls(**values)
+
+
+def _with_preset(raw: Mapping, where: str) -> dict:
+    """Fill sensor keys from the named preset under the explicitly given ones."""
+    raw = dict(raw)
+    sensor = raw.get("sensor")
+    if isinstance(sensor, Mapping) and sensor.get("preset"):
+        if sensor["preset"] not in PRESETS:
+            raise ConfigError(f"{where}: sensor.preset = {sensor['preset']!r}: allowed values: {', '.join(map(repr, PRESETS))}")
+        raw["sensor"] = {**PRESETS[sensor["preset"]], **sensor}
+    return raw
+
+
+def _check_references(sc: Scenario, where: str) -> Scenario:
+    """Cross-field rules that a single field's range cannot express."""
+    names = [g.name for g in sc.groups]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{where}: groups: names must be unique, got {names}")
+    if not sc.groups:
+        raise ConfigError(f"{where}: groups: at least one [[groups]] table is required")
+    for i, g in enumerate(sc.groups):
+        if g.motion == "carried":
+            if g.carrier not in names or g.carrier == g.name:
+                raise ConfigError(f"{where}: groups.{i}.carrier = {g.carrier!r}: must name another group, one of {names}")
+            if g.birth_rate > 0:
+                raise ConfigError(f"{where}: groups.{i}.birth_rate: carried targets are only placed at reset")
+        x0, y0, x1, y1 = g.region
+        if x1 <= x0 or y1 <= y0:
+            raise ConfigError(f"{where}: groups.{i}.region = {g.region}: need x0 < x1 and y0 < y1")
+    for i, d in enumerate(sc.doors):
+        if d.group and d.group not in names:
+            raise ConfigError(f"{where}: doors.{i}.group = {d.group!r}: allowed values: {names}")
+    ww, wh = sc.world_size
+    if ww < sc.render.width or wh < sc.render.height:
+        raise ConfigError(f"{where}: world.size = {sc.world.size}: must be at least the image size "
+                          f"({sc.render.width}, {sc.render.height}) or 0")
+    if sc.sensor.model == "foreground" and sc.render.camera in ("pan", "follow"):
+        raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = "
+                          f"{sc.render.camera!r}")
+    return _check_budget(sc, where)
+
+
+LABEL_MAX = 65535  # the uint16 label map holds slot + 1 of every target alive
+MEMORY_BUDGET = 4 * 2**30  # bytes; a scenario estimated to need more is refused before anything is allocated
+
+
+def memory_estimate(sc: Scenario) -> int:
+    """Bytes an episode of `sc` needs at its peak, roughly: the world backdrop (about 100 bytes a pixel while its
+    noise is made in float64, 3 once done), each image pixel's frame, label map, noise bank and detector model
+    (40 bytes), and each target's arrays and pymunk body (2 KB)."""
+    ww, wh = sc.world_size
+    margin = 8 * sc.render.shake if sc.render.camera == "shake" else 0.0
+    world_px = (ww + margin) * (wh + margin)
+    image_px = sc.render.width * sc.render.height
+    per_world_px = 3 if sc.render.background == "flat" else 100
+    return int(world_px * per_world_px + image_px * 40 + sum(g.count for g in sc.groups) * 2048)
+
+
+def _check_budget(sc: Scenario, where: str) -> Scenario:
+    """Totals no single field's range bounds: targets against the label map's range, the memory an episode needs."""
+    total = sum(g.count for g in sc.groups)
+    if total > LABEL_MAX:
+        counts = " + ".join(str(g.count) for g in sc.groups)
+        raise ConfigError(f"{where}: groups[].count: {counts} = {total} targets at reset; at most {LABEL_MAX} can be "
+                          "alive at once (the uint16 label map's range)")
+    need = memory_estimate(sc)
+    if need > MEMORY_BUDGET:
+        ww, wh = sc.world_size
+        raise ConfigError(f"{where}: this scenario would need about {need / 2**30:.1f} GiB (world.size {ww:g} x {wh:g} "
+                          f"px, image {sc.render.width} x {sc.render.height} px, {total} targets); the budget is "
+                          f"{MEMORY_BUDGET / 2**30:.0f} GiB: make the world or the image smaller")
+    return sc
+
+
+def from_mapping(raw: Mapping, where: str = "<config>") -> Scenario:
+    """Build and validate a Scenario from a nested mapping (as read from TOML)."""
+    if not isinstance(raw, Mapping):
+        raise ConfigError(f"{where}: expected a table of scenario keys, got {type(raw).__name__}")
+    raw = _with_preset(raw, where)
+    return _check_references(_build(Scenario, raw, where), where)
+
+
+# ---------------------------------------------------------------- files and overrides
+
+def scenario_dir():
+    """The folder of shipped scenario files: package data `mtt_sim.scenarios`, or `scenarios/` in a source checkout."""
+    try:
+        return resources.files("mtt_sim.scenarios")
+    except ModuleNotFoundError:
+        return Path(__file__).resolve().parent.parent / "scenarios"
+
+
+def available() -> dict[str, str]:
+    """Shipped scenario keys (file stems) mapped to the first sentence of their description."""
+    out = {}
+    for entry in sorted(scenario_dir().iterdir(), key=lambda p: p.name):
+        if entry.name.endswith(".toml"):
+            desc = load_raw(entry.name[:-5])[0].get("description", "")
+            out[entry.name[:-5]] = desc.split(". ")[0].strip().rstrip(".")
+    return out
+
+
+@functools.cache
+def shipped_names() -> dict[str, str]:
+    """Shipped scenario keys mapped to their CamelCase names (the env id of key k is mtt_sim/<name>-v0)."""
+    return {p.name[:-5]: tomllib.loads(p.read_text()).get("name", "Custom")
+            for p in sorted(scenario_dir().iterdir(), key=lambda p: p.name) if p.name.endswith(".toml")}
+
+
+def is_sequence(path) -> bool:
+    """Whether `path` is a folder laid out as a MOTChallenge sequence (seqinfo.ini, det/det.txt or gt/gt.txt)."""
+    p = Path(path)
+    return p.is_dir() and any((p / f).is_file() for f in ("seqinfo.ini", "det/det.txt", "gt/gt.txt"))
+
+
+def resolve(name: str | Path) -> str | Path:
+    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml file or a
+    recorded sequence's folder is returned as a Path. An unknown name gets the list of keys and, for a near miss, a
+    suggestion."""
+    if Path(name).is_dir():
+        if not is_sequence(name):
+            raise ConfigError(f"{str(name)!r} is a folder but not a MOTChallenge sequence (no seqinfo.ini, det/det.txt "
+                              "or gt/gt.txt in it)")
+        return Path(name)
+    if isinstance(name, Path) or str(name).endswith(".toml"):
+        if not Path(name).is_file():
+            raise ConfigError(f"scenario file {str(name)!r}: not found")
+        return Path(name)
+    keys = shipped_names()
+    spellings = {k.lower(): k for k in keys} | {f"mtt_sim/{n}-v0".lower(): k for k, n in keys.items()}
+    typed = str(name).strip().lower()
+    if typed in spellings:
+        return spellings[typed]
+    near = difflib.get_close_matches(typed, spellings, n=1, cutoff=0.7)
+    raise ConfigError(f"unknown scenario {str(name)!r}" + (f" (did you mean {spellings[near[0]]!r}?)" if near else "")
+                      + f"; available: {', '.join(keys)} (in any case, or their env ids, a .toml file or a sequence folder)")
+
+
+def load_raw(key_or_path: str | Path, seen: tuple[str, ...] = ()) -> tuple[dict, str]:
+    """Read a scenario's TOML mapping by shipped key (see `resolve`) or file path; returns (mapping, where).
+    A file with `base = "<scenario>"` is that scenario's mapping with the file's keys merged over it (a variant)."""
+    found = resolve(key_or_path)
+    if isinstance(found, Path):
+        text, where = found.read_text(), str(found)
+    else:
+        text, where = (scenario_dir() / f"{found}.toml").read_text(), f"scenarios/{found}.toml"
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{where}: invalid TOML: {err}") from None
+    if "base" not in raw:
+        return raw, where
+    base = raw.pop("base")
+    if not isinstance(base, str) or base in seen:
+        raise ConfigError(f"{where}: base = {base!r}: expected the name of another scenario, without a cycle")
+    try:
+        return merge(load_raw(base, (*seen, str(found)))[0], raw), where
+    except ConfigError as err:
+        raise ConfigError(f"{where}: base = {base!r}: {err}") from None
+
+
+def expand_dotted(overrides: Mapping, prefix: str = "") -> dict:
+    """Turn {"sensor.pd": 0.5} and nested dicts alike, or any mix of the two, into one nested dict.
+
+    Integer keys are list indices ({"groups": {0: {...}}} is "groups.0..."). A value given twice (say as
+    "sensor.pd" and inside "sensor") is an error, never silently dropped.
+    """
+    if not isinstance(overrides, Mapping):
+        raise ConfigError(f"config overrides must be a mapping of keys to values, got {type(overrides).__name__}")
+    out: dict = {}
+    for key, value in overrides.items():
+        if isinstance(key, int) and not isinstance(key, bool):
+            key = str(key)
+        if not isinstance(key, str) or not key or "" in key.split("."):
+            raise ConfigError(f"override key {prefix}{key!r}: keys are dotted names such as 'sensor.pd'")
+        node, path = out, prefix
+        *parents, leaf = key.split(".")
+        for part in parents:
+            path += part + "."
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"override {path.rstrip('.')} is given both as a value and as a table of keys")
+        if isinstance(value, Mapping):
+            value = expand_dotted(value, f"{path}{leaf}.")
+        _put(node, leaf, value, path)
+    return out
+
+
+def _put(node: dict, key: str, value, prefix: str) -> None:
+    """node[key] = value, merging tables and refusing a second value for the same key."""
+    if key not in node:
+        node[key] = value
+    elif isinstance(node[key], dict) and isinstance(value, dict):
+        for k, v in value.items():
+            _put(node[key], k, v, f"{prefix}{key}.")
+    else:
+        raise ConfigError(f"override {prefix}{key} is given twice (e.g. as a dotted key and inside a table); give it once")
+
+
+def merge(base: Mapping, overrides: Mapping, prefix: str = "") -> dict:
+    """Recursively merge `overrides` into `base`; list items are addressed by index ("groups.0.count",
+    "groups.0.size.0")."""
+    out = dict(base)
+    for key, value in overrides.items():
+        out[key] = _merged(out.get(key), value, f"{prefix}{key}")
+    return out
+
+
+def _merged(current, value, path: str):
+    if isinstance(current, Mapping) and isinstance(value, Mapping):
+        return merge(current, value, path + ".")
+    if isinstance(current, (list, tuple)) and isinstance(value, Mapping):
+        items = list(current)
+        for idx, sub in value.items():
+            if not (isinstance(idx, str) and idx.isdigit() and int(idx) < len(items)):
+                raise ConfigError(f"override {path}.{idx}: no such item; {path} has {len(items)} entries")
+            items[int(idx)] = _merged(items[int(idx)], sub, f"{path}.{idx}")
+        return items
+    return value
+
+
+def to_mapping(obj) -> Any:
+    """A Scenario (or part) as plain nested dicts and lists, the inverse of `from_mapping`."""
+    if dataclasses.is_dataclass(obj):
+        return {f.name: to_mapping(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, tuple):
+        return [to_mapping(x) for x in obj]
+    return obj
+
+
+def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -> Scenario:
+    """Load a shipped scenario (by key), a TOML file or an existing Scenario, with optional overrides."""
+    if isinstance(key_or_path, Scenario):
+        raw, where = to_mapping(key_or_path), f"scenario {key_or_path.name}"
+    elif is_sequence(key_or_path):
+        from mtt_sim.real.sequence import Recording  # here: the recorded source builds on this module
+
+        return Recording(key_or_path).scenario(overrides)
+    else:
+        raw, where = load_raw(key_or_path)
+    if overrides:
+        if not isinstance(overrides, Mapping):
+            raise ConfigError(f"config overrides must be a mapping, got {type(overrides).__name__}")
+        try:
+            raw = merge(raw, expand_dotted(overrides))
+        except ConfigError as err:
+            raise ConfigError(f"{where}: {err}") from None
+        where += " (with overrides)"
+    sc = from_mapping(raw, where)
+    if sc.sensor.model == "recorded":
+        raise ConfigError(f"{where}: sensor.model = 'recorded' replays a sequence folder's det/det.txt; a scenario's "
+                          "detector is 'synthetic' or 'foreground'")
+    return sc
+
+
+def read_sensor(path: str | Path) -> dict:
+    """The [sensor] table of a TOML file (as `mtt-sim calibrate` writes), to be merged into a scenario's overrides."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such sensor file (a TOML file with a [sensor] table, e.g. from mtt-sim calibrate)")
+    try:
+        table = tomllib.loads(path.read_text()).get("sensor")
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: invalid TOML: {err}") from None
+    if not isinstance(table, Mapping):
+        raise ConfigError(f"{path}: expected a [sensor] table")
+    return {"sensor": dict(table)}
+
+
+def reference_table() -> str:
+    """Markdown table of every configuration key: key, default, unit, allowed values, meaning."""
+    rows = ["| key | default | unit | allowed | meaning |", "|---|---|---|---|---|"]
+
+    def walk(cls, prefix):
+        hints = _hints(cls)
+        for f in dataclasses.fields(cls):
+            tp, meta = hints[f.name], f.metadata
+            inner = typing.get_args(tp)[0] if typing.get_origin(tp) is tuple else None
+            if dataclasses.is_dataclass(tp):
+                walk(tp, prefix + f.name + ".")
+                continue
+            if inner is not None and dataclasses.is_dataclass(inner):
+                walk(inner, f"{prefix}{f.name}[].")
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            if meta.get("choices"):
+                allowed = ", ".join(repr(c) for c in meta["choices"])
+            else:
+                allowed = _range_text(meta).replace("; allowed: ", "")
+            rows.append(f"| `{prefix}{f.name}` | `{default!r}` | {meta.get('unit', '')} | {allowed} | {meta.get('doc', '')} |")
+
+    walk(Scenario, "")
+    rows += ["", f"Totals: at most {LABEL_MAX} targets at reset (the sum of `groups[].count`, the uint16 label map's "
+                 f"range), and an estimated peak memory (`mtt_sim.sim.scenario.memory_estimate`) of at most "
+                 f"{MEMORY_BUDGET // 2**30} GiB, which bounds `world.size` times the image size."]
+    return "\n".join(rows)
+
+
+__all__ = ["Scenario", "GroupConfig", "DoorConfig", "OccluderConfig", "WorldConfig", "RenderConfig", "SensorConfig",
+           "EnvConfig", "ScoringConfig", "ConfigError", "PRESETS", "available", "load", "load_raw", "from_mapping", "to_mapping",
+           "merge", "expand_dotted", "reference_table", "resolve", "shipped_names"]
+
