@@ -115,6 +115,16 @@ class TrackingEnv(gym.Env):
         self._started = False
         self._done = True
 
+    @property
+    def config(self):
+        """The configuration this env runs with (its env.*, scoring.* and sensor.* tables)."""
+        return self.scenario
+
+    @property
+    def scored(self) -> bool:
+        """Whether the source has ground truth to score against (a recorded sequence without gt/ has none)."""
+        return self.recording is None or self.recording.scored
+
     def _load(self, overrides: Mapping) -> scn.Scenario:
         return self.recording.scenario(overrides) if self.recording else scn.load(self._source, overrides)
 

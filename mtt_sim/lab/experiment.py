@@ -66,7 +66,7 @@ class _Episode:
 
     def record(self, scenario: str, seed: int, config: Mapping | None) -> dict:
         env, frames = self.env, len(self.online)
-        scored = env.recording is None or env.recording.scored
+        scored = env.scored
         return {"tracker": self.tracker, "params": self.agent.params, "scenario": str(scenario), "seed": seed,
                 "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
                 "per_target": env.metrics.per_target() if scored else {},
@@ -86,7 +86,7 @@ def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Map
         raise ValueError("a results file takes one tracker")
     runs = [_Episode(scenario, spec, seed, config, bool(video), scale) for spec in specs]
     writer = VideoWriter(video, runs[0].env.metadata["render_fps"]) if video else None
-    limit = steps or runs[0].env.scenario.env.max_steps
+    limit = steps or runs[0].env.config.env.max_steps
     steps_ = tqdm(range(limit), desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False) \
         if progress else range(limit)
     for _ in steps_:

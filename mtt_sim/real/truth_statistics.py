@@ -20,7 +20,7 @@ def record(scenario: str, config: dict | None = None, seed: int = 0, steps: int 
     env = TrackingEnv(scenario, config=config, obs_mode="detections")
     obs, _ = env.reset(seed=seed)
     truths, detections = [], []
-    for _ in range(steps or env.scenario.env.max_steps):
+    for _ in range(steps or env.config.env.max_steps):
         truths.append(env.truth)
         detections.append(obs["detections"][: int(obs["num_detections"])].astype(float))
         obs, _, terminated, truncated, _ = env.step(NO_TRACKS)
