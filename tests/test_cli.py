@@ -4,6 +4,7 @@ import argparse
 import csv
 import importlib.metadata
 import json
+import math
 import re
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import pytest
 
 from mtt_sim import trackers
 from mtt_sim import cli
+from mtt_sim.cli import arguments
 from mtt_sim.lab import experiment
 from mtt_sim.lab import perf
 from mtt_sim.sim import scenario
@@ -167,7 +169,7 @@ def test_tracker_specs_with_several_parameters_and_seed_forms(tmp_path, capsys):
     rows = list(csv.DictReader(out.open()))
     assert [r["tracker"] for r in rows] == ["sort:min_hits=1,max_age=5"] * 2 + ["iou"] * 2 + ["gnn:coast=true"] * 2
     assert json.loads(rows[0]["params"])["max_age"] == 5 and [r["seed"] for r in rows[:2]] == ["3", "7"]
-    assert cli.parse_seeds("100-102,7") == [100, 101, 102, 7] and cli.parse_seeds("3") == [0, 1, 2]
+    assert arguments.parse_seeds("100-102,7") == [100, 101, 102, 7] and arguments.parse_seeds("3") == [0, 1, 2]
     assert trackers.split_specs("sort:min_hits=1,max_age=5;iou") == ["sort:min_hits=1,max_age=5", "iou"]
 
 
@@ -202,8 +204,12 @@ def test_export_into_an_older_longer_export_leaves_no_stale_frames(tmp_path, cap
 
 
 def test_a_long_run_shows_progress(monkeypatch, capsys):
-    bars = []
-    monkeypatch.setattr(experiment, "tqdm", lambda *a, **k: bars.append(k) or a[0])
+    bars, tqdm = [], experiment.tqdm
+
+    def spy(*args, **kwargs):  # the bar's settings kept, the bar itself hidden (an iterable or a context manager)
+        bars.append(kwargs)
+        return tqdm(*args, **{**kwargs, "disable": True})
+    monkeypatch.setattr(experiment, "tqdm", spy)
     assert cli.main(["run", "crossing", "--steps", "3"]) == 0
     assert bars and bars[0]["delay"] == 1.0  # shown once a run has taken a second
 
@@ -211,7 +217,29 @@ def test_a_long_run_shows_progress(monkeypatch, capsys):
 @pytest.mark.parametrize("text, value", [("sensor.pd=0.5", 0.5), ("render.camera=shake", "shake"),
                                          ("world.walls=true", True), ("groups.0.size=[10, 20]", [10, 20])])
 def test_config_values_are_read_as_toml(text, value):
-    assert cli.parse_overrides([text]) == {text.split("=")[0]: value}
+    assert arguments.parse_overrides([text]) == {text.split("=")[0]: value}
+
+
+def _table(text: str) -> tuple[list[str], list[list[str]]]:
+    """A markdown table's header cells and body rows' cells."""
+    lines = [line for line in text.splitlines() if line.startswith("|")]
+    header, *rows = ([c.strip() for c in line.strip("|").split("|")] for line in lines)
+    assert set(rows[0]) <= {"---", "---:"}
+    return header, rows[1:]
+
+
+def _printed(cell: str) -> tuple[float, float]:
+    """A printed number ("1234", "0.52x", "12 us", "1.5 s") and half a unit of its last digit."""
+    text = cell.split(" ")[0].removesuffix("x")
+    return float(text), 0.5 * 10.0 ** -len(text.partition(".")[2])
+
+
+def _is_ratio(ratio: str, top: str, bottom: str) -> bool:
+    """The printed ratio is top / bottom of the printed columns, within the rounding of all three."""
+    (r, dr), (t, dt), (b, db) = _printed(ratio), _printed(top), _printed(bottom)
+    least = (t - dt) / (b + db)
+    most = (t + dt) / (b - db) if b > db else math.inf
+    return least <= r + dr and r - dr <= most
 
 
 def test_config_reference_and_perf_report_shape(capsys):
@@ -219,36 +247,72 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert "| `sensor.clutter_rate` |" in capsys.readouterr().out
     rows = perf.measure(repeats=1, steps=4)
     assert [r["targets"] for r in rows] == [20, 200]
-    assert all(r["frames_steps_per_s"] > 0 and r["step_over_reference"] > 0 for r in rows)
-    assert "step / reference" in perf.report(rows)
+    assert all(math.isclose(r["step_over_reference"], r["reference_per_s"] / r["frames_steps_per_s"]) for r in rows)
+    header, cells = _table(perf.report(rows))
+    assert header == ["targets", "steps/s with frames", "steps/s detections only", "reference frames/s",
+                      "step / reference"]
+    assert [c[0] for c in cells] == ["20", "200"] and all(_is_ratio(c[4], c[3], c[1]) for c in cells)
     rows = perf.measure_metrics(repeats=1)
-    assert [r["objects"] for r in rows] == [20, 200] and all(r["update_us"] > 0 and r["summary_s"] > 0 for r in rows)
-    assert "update / reference" in perf.report_metrics(rows)
+    assert [(r["objects"], r["frames"]) for r in rows] == [(20, 1000), (200, 100)]
+    assert all(math.isclose(r["update_over_reference"], r["update_us"] / r["reference_us"]) for r in rows)
+    header, cells = _table(perf.report_metrics(rows))
+    assert header == ["objects", "frames", "update per frame", "reference per frame", "update / reference",
+                      "summary of all frames"]
+    assert [c[:2] for c in cells] == [["20", "1000"], ["200", "100"]]
+    assert all(_is_ratio(c[4], c[2], c[3]) for c in cells)
+    assert all(c[2].endswith(" us") and c[3].endswith(" us") and c[5].endswith(" ms") for c in cells)
     row = perf.measure_metrics_memory(repeats=1, objects=20, frames=300)
-    assert 0 < row["kb_per_frame"] < 5 and row["summary_s"] > 0 and 1 <= row["peak_over_stored"] < 4
-    assert "stored per frame" in perf.report_metrics_memory(row)
+    assert 0 < row["kb_per_frame"] < 5 and math.isfinite(row["summary_s"]) and 1 <= row["peak_over_stored"] < 4
+    header, cells = _table(perf.report_metrics_memory(row))
+    assert header == ["objects", "frames", "stored per frame", "summary", "summary peak / stored"]
+    assert cells == [["20", "300", f"{row['kb_per_frame']:.1f} KB", f"{row['summary_s']:.2f} s",
+                      f"{row['peak_over_stored']:.2f}x"]]
     rows = perf.measure_pf(repeats=1, frames=2)
-    assert [r["tracker"].split()[0] for r in rows] == ["pf", "ipf", "pf,", "ipf,"] and all(r["fps"] > 0 for r in rows)
-    assert "| ipf (Liu et al. 2011), 4 x 100 particles, 640x480 |" in perf.report_pf(rows)
-    assert "| ipf, 30 x 100 particles, mot17_like 960x540 |" in perf.report_pf(rows)
+    assert [r["tracker"] for r in rows] == ["pf (Li et al. 2007), 1 x 60 particles, 768x576",
+                                            "ipf (Liu et al. 2011), 4 x 100 particles, 640x480",
+                                            "pf, 30 x 60 particles, mot17_like 960x540",
+                                            "ipf, 30 x 100 particles, mot17_like 960x540"]
+    header, cells = _table(perf.report_pf(rows))
+    assert header == ["tracker", "frames/s", "per-particle calcHist frames/s (its histogram only)",
+                      "tracker / reference"]
+    assert [c[0] for c in cells] == [r["tracker"] for r in rows] and all(_is_ratio(c[3], c[1], c[2]) for c in cells)
 
 
 def test_perf_tables_of_scenarios_scaling_rfs_trackers_and_sweeps():
     rows = perf.measure_scenarios(repeats=1, steps=2)
-    assert {r["scenario"] for r in rows} == set(scenario.available()) and all(r["steps_per_s"] > 0 for r in rows)
-    assert "| mot17_like | 960x540 |" in perf.report_scenarios(rows)
+    assert [r["scenario"] for r in rows] == sorted(scenario.available())
+    assert all(math.isclose(r["step_over_reference"], r["reference_per_s"] / r["steps_per_s"]) for r in rows)
+    header, cells = _table(perf.report_scenarios(rows))
+    assert header == ["scenario", "image", "targets (first frame)", "steps/s", "reference frames/s", "step / reference"]
+    assert [c[:3] for c in cells] == [[r["scenario"], r["image"], str(r["targets"])] for r in rows]
+    assert ["mot17_like", "960x540"] in [c[:2] for c in cells] and all(_is_ratio(c[5], c[4], c[3]) for c in cells)
     rows = perf.measure_scaling(repeats=1, steps=1)
     assert [(r["targets"], r["image"]) for r in rows] == [(n, size) for size in ("640x480", "1920x1080")
                                                           for n in (20, 200, 2000)]
     assert all(abs(sum(r[k] for k in perf.STAGES) - r["total"]) < 1e-9 and min(r[k] for k in perf.STAGES) >= 0
                for r in rows if r["other"] >= 0)
-    assert "growth, 200 -> 2000 targets (10x) at 640x480: world" in perf.report_scaling(rows)
+    text = perf.report_scaling(rows)
+    header, cells = _table(text)
+    assert header == ["targets", "image", "steps/s", *perf.STAGES] and [c[:2] for c in cells] == [
+        [str(r["targets"]), r["image"]] for r in rows]
+    assert all(_is_ratio(c[2], "1000", str(r["total"])) for c, r in zip(cells, rows))
+    assert "growth, 200 -> 2000 targets (10x) at 640x480: world" in text
+    assert "growth, 640x480 -> 1920x1080 (6.75x the pixels) at 200 targets: world" in text
     rows = perf.measure_rfs(repeats=1, frames=3)
-    assert [r["tracker"] for r in rows] == ["gmphd", "gmphd", "lmb:reid=false", "lmb"] and all(r["ms"] > 0 for r in rows)
-    assert "| gmphd | mot17_like |" in perf.report_rfs(rows)
+    dense = "dense (count=100, pd=0.9, clutter_rate=10.0)"
+    assert [(r["tracker"], r["workload"]) for r in rows] == [("gmphd", "mot17_like"), ("gmphd", dense),
+                                                             ("lmb:reid=false", dense), ("lmb", dense)]
+    assert all(math.isclose(r["over_gnn"], r["ms"] / r["gnn_ms"]) for r in rows)
+    assert rows[1]["gnn_ms"] == rows[2]["gnn_ms"] == rows[3]["gnn_ms"]  # one reference per workload
+    header, cells = _table(perf.report_rfs(rows))
+    assert header == ["tracker", "workload", "ms/frame", "frames/s", "gnn ms/frame", "tracker / gnn"]
+    assert [c[:2] for c in cells] == [[r["tracker"], r["workload"]] for r in rows]
+    assert all(_is_ratio(c[5], c[2], c[4]) and _is_ratio(c[3], "1000", c[2]) for c in cells)
     row = perf.measure_sweeps(repeats=1, config={"env.max_steps": 3})
-    assert row["episodes"] == 24 and row["one_s"] > 0 and row["two_s"] > 0
-    assert "| 1 worker | 2 workers | speed-up |" in perf.report_sweeps(row)
+    assert row["episodes"] == 24 and math.isclose(row["speedup"], row["one_s"] / row["two_s"])
+    header, cells = _table(perf.report_sweeps(row))
+    assert header == ["1 worker", "2 workers", "speed-up"] and len(cells) == 1
+    assert _is_ratio(cells[0][2], cells[0][0], cells[0][1])
 
 
 def test_sweep_and_bench_plot_one_panel_per_metric(tmp_path, capsys):

@@ -1,0 +1,23 @@
+"""`mtt-sim check-real`: hold sort, bytetrack and the scoring against real MOTChallenge data and the reference
+codes' outputs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mtt_sim.cli.arguments import UsageError
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("check-real", help="hold sort, bytetrack and the scoring against real MOTChallenge data "
+                                                 "and the reference codes' outputs")
+    p.add_argument("data", help="the shared data folder (mot15/, reference/, mot17/, mot17_results/)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    if not (Path(args.data) / "mot15").is_dir():
+        raise UsageError("data", f"{args.data!r}: expected the shared data folder (with mot15/, reference/, mot17/)")
+    from mtt_sim.real import check
+
+    return 0 if check.check(args.data) else 1

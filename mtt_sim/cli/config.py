@@ -1,0 +1,25 @@
+"""`mtt-sim config`: the configuration reference, or one scenario's configuration with the overrides applied."""
+
+from __future__ import annotations
+
+import json
+
+from mtt_sim.cli.arguments import CONFIG_HELP, SCENARIO_HELP, add_overrides, episode_overrides, loaded, scenario_key
+from mtt_sim.sim import scenario
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("config", help="the configuration reference, or one scenario's resolved configuration")
+    p.add_argument("scenario", nargs="?", type=scenario_key, help=SCENARIO_HELP)
+    add_overrides(p, CONFIG_HELP)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    overrides = episode_overrides(args)
+    if args.scenario:
+        loaded([args.scenario], overrides)
+        print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, overrides)), indent=2))
+    else:
+        print(scenario.reference_table())
+    return 0

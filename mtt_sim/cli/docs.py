@@ -1,0 +1,29 @@
+"""`mtt-sim docs`: build the documentation site with MkDocs (the [docs] extra)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mtt_sim.cli.arguments import FORCE_HELP, output_folder, require
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("docs", help="build the documentation site (MkDocs): the README, a page per scenario "
+                                           "and per tracker, the configuration reference (the [docs] extra)")
+    p.add_argument("--out", required=True, help="the site's folder")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    out = output_folder(args.out, args.force, "--out", "replace the site")
+    require("mkdocs", "docs", "docs")
+    require("material", "docs", "docs")
+    import tempfile
+
+    from mtt_sim.show import docsite
+
+    with tempfile.TemporaryDirectory() as work:
+        docsite.build(out, Path(work))
+    print(f"site: {out / 'index.html'}")
+    return 0

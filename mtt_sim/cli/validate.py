@@ -1,0 +1,33 @@
+"""`mtt-sim validate`: the sim-to-real check, trackers on real detections against their synthetic twins."""
+
+from __future__ import annotations
+
+from mtt_sim.cli.arguments import FORCE_HELP, calibration_folder, integer, output_file, replaced, tracker_specs
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("validate", help="the sim-to-real check: trackers on real detections against the twins "
+                                               "(fitted here, on the other sequences, memoryless)")
+    p.add_argument("folders", nargs="+", type=calibration_folder, metavar="DIR",
+                   help="sequence folders with gt/gt.txt and det/det.txt (two or more for leave-one-out)")
+    p.add_argument("--trackers", type=tracker_specs, default=None,
+                   help="tracker specs (default: sort,iou,bytetrack,gnn,gmphd,lmb:reid=false,jpda)")
+    p.add_argument("--seeds", type=integer(1), default=3, help="twin episodes per sequence and tracker (default 3)")
+    p.add_argument("--workers", type=integer(1), default=1, help="parallel processes (default 1)")
+    p.add_argument("--out", help="also write the tables to this Markdown file (.md)")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    out = output_file(args.out, args.force, "--out", (".md",))
+    from mtt_sim.real import validate
+
+    result = validate.validate(args.folders, args.trackers or validate.TRACKERS, seeds=args.seeds, workers=args.workers,
+                               progress=True)
+    text = validate.markdown(result)
+    print(text)
+    if out:
+        out.write_text(text)
+        print(f"tables: {out}" + replaced(args.force))
+    return 1 if result.failed else 0
