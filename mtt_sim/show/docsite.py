@@ -1,11 +1,12 @@
-"""`mtt-sim docs`: the documentation site, built with MkDocs (Material theme) from what the code already says: the
-README as the front page, a page per scenario (a still and a short GIF of the tracker it suits, its description,
-its TOML file), a page per tracker (its docstring and its parameters with their ranges and meanings) and the
-configuration reference. Needs the [docs] extra."""
+"""`mtt-sim docs`: the documentation site, built with MkDocs (Material theme). The pages under docs/ are its single
+source, docs/index.md its landing page; to them it adds what the code already says: a page per scenario (a still
+and a short GIF of the tracker it suits, its description, its TOML file), a page per tracker (its docstring and its
+parameters with their ranges and meanings) and the configuration reference. Needs the [docs] extra."""
 
 from __future__ import annotations
 
 import inspect
+import json
 import shutil
 import subprocess
 import sys
@@ -23,6 +24,31 @@ from mtt_sim.sim import scenario
 from mtt_sim.lab.experiment import run_episodes
 
 ROOT = Path(__file__).resolve().parents[2]  # the source checkout
+DOCS = ROOT / "docs"  # the site's pages, images and notebooks
+# The site's navigation: (title, page under docs/) or (section, [(title, page), ...]). "scenarios/" and "trackers/"
+# stand for the generated pages, one per scenario and per tracker, after the section's overview page.
+NAV = [("Home", "index.md"),
+       ("The Gym loop", "gym.md"),
+       ("Trackers", [("Trackers", "trackers.md"), ("One page each", "trackers/")]),
+       ("Scenarios", [("Scenarios", "scenarios.md"), ("One page each", "scenarios/")]),
+       ("Metrics", "metrics.md"),
+       ("Configuration", "config.md"),
+       ("Command line", "cli.md"),
+       ("Cookbook", "cookbook.md"),
+       ("Papers", [("JPDA (Wan, Wang and Yuan 2011)", "jpda.md"),
+                   ("Colour and texture particle filter (Li, Zhang and Li 2007)", "colour_pf.md"),
+                   ("Interactive particle filter (Liu et al. 2011)", "ipf.md"),
+                   ("LMB (Jiang and Yang)", "lmb.md")]),
+       ("Real data", [("Real sequences and the digital twin", "real_data.md"),
+                      ("The sim-to-real check", "validate.md"),
+                      ("Detector presets", "detectors.md")]),
+       ("Performance", "performance.md"),
+       ("Tests", "tests.md")]
+
+
+def nav_pages() -> list[str]:
+    """Every page NAV names, in order ("scenarios/" and "trackers/" for the generated ones)."""
+    return [page for _, item in NAV for page in ([item] if isinstance(item, str) else [p for _, p in item])]
 GIF_FRAMES = 40
 # The trackers each scenario was made for (the papers' scenes) or suits best, the first drawn in its still.
 SUITS = {"crossing": ("jpda", "gnn"), "soccer": ("jpda", "gnn"), "umbrellas": ("pf",), "books": ("ipf", "pcpf"),
@@ -70,13 +96,28 @@ def tracker_page(name: str) -> str:
                       "command line.", "", *rows, ""])
 
 
+def nav_lines(keys: list[str], names: list[str]) -> list[str]:
+    """NAV as mkdocs.yml lines, the generated pages spelled out: one per scenario `keys`, per tracker `names`."""
+    generated = {"scenarios/": [(k, f"scenarios/{k}.md") for k in keys],
+                 "trackers/": [(n, f"trackers/{n}.md") for n in names]}
+    lines = []
+    for title, item in NAV:
+        if isinstance(item, str):
+            lines.append(f"  - {json.dumps(title)}: {item}")
+            continue
+        lines.append(f"  - {json.dumps(title)}:")
+        for sub_title, page in item:
+            lines += [f"    - {json.dumps(t)}: {p}" for t, p in generated.get(page, [(sub_title, page)])]
+    return lines
+
+
 def write_sources(folder: Path) -> None:
-    """The site's Markdown, images and mkdocs.yml under `folder` (the MkDocs project)."""
+    """The site's Markdown, images and mkdocs.yml under `folder` (the MkDocs project): a copy of docs/, the
+    generated pages beside it, and the configuration reference from the code (docs/config.md is its copy)."""
     docs = folder / "docs"
+    shutil.copytree(DOCS, docs, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
     for sub in ("scenarios", "trackers"):
         (docs / sub).mkdir(parents=True, exist_ok=True)
-    (docs / "index.md").write_text((ROOT / "README.md").read_text())
-    shutil.copytree(ROOT / "docs", docs / "docs", dirs_exist_ok=True)  # the README's images and notebooks
     (docs / "config.md").write_text("# Configuration\n\n" + scenario.reference_table() + "\n")
     keys = sorted(scenario.available())
     for key in keys:
@@ -84,10 +125,8 @@ def write_sources(folder: Path) -> None:
     names = sorted(trackers.base.REGISTRY)
     for name in names:
         (docs / "trackers" / f"{name}.md").write_text(tracker_page(name))
-    nav = ["  - Home: index.md", "  - Scenarios:", *[f"    - {k}: scenarios/{k}.md" for k in keys], "  - Trackers:",
-           *[f"    - {n}: trackers/{n}.md" for n in names], "  - Configuration: config.md"]
-    (folder / "mkdocs.yml").write_text("\n".join(["site_name: mtt-sim", "theme:", "  name: material", "nav:", *nav,
-                                                  ""]))
+    (folder / "mkdocs.yml").write_text("\n".join(["site_name: mtt-sim", "theme:", "  name: material", "nav:",
+                                                  *nav_lines(keys, names), ""]))
 
 
 def build(out: Path, work: Path) -> None:
@@ -97,8 +136,8 @@ def build(out: Path, work: Path) -> None:
         import mkdocs  # noqa: F401
     except ImportError:
         raise ImportError("the docs site needs MkDocs: pip install 'mtt-sim[docs]'") from None
-    if not (ROOT / "README.md").is_file() or not (ROOT / "docs").is_dir():
-        raise FileNotFoundError(f"the docs site is built from a source checkout: no README.md and docs/ in {ROOT}")
+    if not (DOCS / "index.md").is_file():
+        raise FileNotFoundError(f"the docs site is built from a source checkout: no docs/index.md in {ROOT}")
     write_sources(work)
     done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--quiet", "--config-file",
                            str(work / "mkdocs.yml"), "--site-dir", str(Path(out).resolve())],
