@@ -350,7 +350,10 @@ def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
 def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
     site = tmp_path / "site"
     assert cli.main(["docs", "--out", str(site)]) == 0
-    assert "site: " in capsys.readouterr().out and (site / "index.html").exists()
+    assert "site: " in capsys.readouterr().out
+    landing = (site / "index.html").read_text()  # docs/index.md, not the README: it links the pages
+    assert "Find your way" in landing and 'href="jpda/"' in landing and "trackers.register" not in landing
+    assert "Fig. 14" in (site / "ipf" / "index.html").read_text()
     for key in scenario.available():
         page = (site / "scenarios" / key / "index.html").read_text()
         assert key in page and (site / "scenarios" / f"{key}.jpg").stat().st_size > 5000
