@@ -1,10 +1,8 @@
-"""TrackingEnv: the Gymnasium face of the simulator, and of recorded sequences.
+"""TrackingEnv: the Gymnasium face of a source of frames, a simulated scene or a recorded sequence.
 
-Each step the agent answers the current observation (frame and detections) with its tracks;
-the environment scores those tracks against the current ground truth, advances the world one
-frame, renders it, runs the detector and returns the next observation. A recorded MOTChallenge
-sequence (`mtt_sim.sequence`) takes the place of world, renderer and detector: its frames,
-detections and ground truth are read instead of made.
+Each step the agent answers the current observation (frame and detections) with its tracks; the environment scores
+those tracks against the frame's ground truth, moves its source on one frame and returns the next observation. The
+source (`mtt_sim.sources`) makes or reads the truth, detections and frames; the env never asks which kind it holds.
 """
 
 from __future__ import annotations
@@ -17,16 +15,11 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtt_sim.sim import scenario as scn
-from mtt_sim.show import viewer
-from mtt_sim.sim.scenario import is_sequence
-from mtt_sim.real.sequence import Recording
 from mtt_sim.metrics import EpisodeMetrics, FrameStats
+from mtt_sim.show import viewer
 from mtt_sim.show.overlay import draw_banner, draw_debug, draw_legend, draw_overlay, running_metrics
-from mtt_sim.sim.render import Renderer
-from mtt_sim.sim.sensor import Detections, SyntheticSensor, make_sensor
-from mtt_sim.sim.truth import Truth, measure
-from mtt_sim.sim.world import World
+from mtt_sim.sim import scenario as scn
+from mtt_sim.sources import Source, open_source
 
 _SPACE_KEYS = ("render.width", "render.height", "sensor.model", "sensor.max_detections", "sensor.conf_offset",
                "sensor.conf_scale", "env.max_tracks", "env.obs_mode")
@@ -89,17 +82,13 @@ class TrackingEnv(gym.Env):
             overrides = scn.merge(scn.read_sensor(sensor), overrides)
         if obs_mode is not None:
             overrides = scn.merge(overrides, {"env": {"obs_mode": obs_mode}})
-        source = sequence if sequence is not None else scenario
-        if source is None:
+        what = sequence if sequence is not None else scenario
+        if what is None:
             raise ValueError("mtt_sim/Replay-v0 needs sequence='path/to/a/MOTChallenge/sequence/folder'")
-        recorded = sequence is not None or (not isinstance(source, scn.Scenario) and is_sequence(source))
-        if benchmark is not None and not recorded:
-            raise ValueError(f"benchmark={benchmark!r} applies to recorded sequences, not to the scenario {source!r}")
-        self.recording = Recording(source, benchmark) if recorded else None
-        if self.recording is not None and not self.recording.scored:
-            gym.logger.warn(f"{source}: no gt/gt.txt, so this env runs unscored (reward 0, no info['metrics'])")
-        self._source = source
-        self.scenario = self._load(overrides)
+        self._what, self._benchmark, self._recorded = what, benchmark, sequence is not None
+        self.source: Source = open_source(what, overrides, benchmark, self._recorded)
+        if not self.source.scored:
+            gym.logger.warn(f"{what}: no gt/gt.txt, so this env runs unscored (reward 0, no info['metrics'])")
         self._overrides = overrides
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode={render_mode!r}: allowed values: None, 'rgb_array', 'human'")
@@ -110,44 +99,34 @@ class TrackingEnv(gym.Env):
             raise gym.error.DependencyNotInstalled(viewer.HOW)
         self.render_mode = render_mode
         self._viewer = viewer.Viewer("mtt-sim", self.metadata["render_fps"]) if render_mode == "human" else None
-        self.observation_space, self.action_space = self._spaces(self.scenario, self.recording)
-        self.world: World | None = None
+        self.observation_space, self.action_space = self._spaces(self.source)
         self._started = False
         self._done = True
 
     @property
     def config(self):
-        """The configuration this env runs with (its env.*, scoring.* and sensor.* tables)."""
-        return self.scenario
+        """The configuration this env runs with: the source's env.*, scoring.* and sensor.* tables (a scenario's
+        world.*, render.* and groups too)."""
+        return self.source.config
 
     @property
     def scored(self) -> bool:
         """Whether the source has ground truth to score against (a recorded sequence without gt/ has none)."""
-        return self.recording is None or self.recording.scored
-
-    def _load(self, overrides: Mapping) -> scn.Scenario:
-        return self.recording.scenario(overrides) if self.recording else scn.load(self._source, overrides)
+        return self.source.scored
 
     # ------------------------------------------------------------ spaces
 
     @staticmethod
-    def _spaces(sc: scn.Scenario, recording: Recording | None = None):
-        """Simulated detections lie in the image with confidences in conf_offset + [0, conf_scale], and the rows past
-        num_detections are zeros (float32; float64 on a recorded sequence); recorded ones are given as written, so
-        their bounds are widened to the extremes of the sequence's det.txt."""
-        w, h = sc.render.width, sc.render.height
-        nd, nt = sc.sensor.max_detections, sc.env.max_tracks
-        dtype = np.float32 if recording is None else np.float64
-        s = sc.sensor
-        det_low = np.array([0, 0, 0, 0, min(s.conf_offset, 0.0)])
-        det_high = np.array([w, h, w, h, max(s.conf_offset + s.conf_scale, 0.0)])
-        if recording is not None and s.model == "recorded":
-            det_low = np.minimum(det_low, np.floor(recording.det_range[0]))
-            det_high = np.maximum(det_high, np.ceil(recording.det_range[1]))
+    def _spaces(source: Source):
+        """Detections within the source's bounds, in its dtype (float32 simulated, float64 recorded: as written), the
+        rows past num_detections zeros; track boxes in the same dtype, at most one image beyond each border."""
+        (w, h), c = source.image_size, source.config
+        nd, nt, dtype = c.sensor.max_detections, c.env.max_tracks, source.detection_dtype
+        det_low, det_high = source.detection_bounds()
         obs = {"detections": spaces.Box(np.tile(det_low.astype(dtype), (nd, 1)), np.tile(det_high.astype(dtype), (nd, 1)),
                                         (nd, 5), dtype),
                "num_detections": spaces.Discrete(nd + 1)}
-        if sc.env.obs_mode == "frame+detections":
+        if c.env.obs_mode == "frame+detections":
             obs = {"frame": spaces.Box(0, 255, (h, w, 3), np.uint8), **obs}
         box_low = np.tile(np.array([-w, -h, 0, 0], dtype), (nt, 1))  # zero rows pad; used rows need w, h > 0
         box_high = np.tile(np.array([2 * w, 2 * h, 2 * w, 2 * h], dtype), (nt, 1))
@@ -165,20 +144,10 @@ class TrackingEnv(gym.Env):
             raise ValueError(f"reset options: unknown key(s) {sorted(unknown)}; allowed: 'config'")
         if "config" in options:
             self._reconfigure(options["config"])
-        sc = self.scenario
-        world_rng, render_rng, sensor_rng = (np.random.default_rng(s) for s in
-                                            np.random.SeedSequence(self.np_random.integers(2**63)).spawn(3))
-        if self.recording is None:
-            self.world = World(sc, world_rng)
-            self.renderer = Renderer(sc, render_rng)
-            if sc.render.camera == "follow":
-                self.renderer.camera.follow(self.world)
-            empty = self.renderer.render(self.world, show_targets=False)[0] if sc.sensor.model == "foreground" else None
-            self.sensor = make_sensor(sc, sensor_rng, empty)
-        else:
-            self.sensor = SyntheticSensor(sc, sensor_rng) if sc.sensor.model == "synthetic" else None
+        rngs = (np.random.default_rng(s) for s in np.random.SeedSequence(self.np_random.integers(2**63)).spawn(3))
+        self.source.reset(*rngs)
         self._started = True
-        s = sc.scoring
+        s = self.config.scoring
         self.metrics = EpisodeMetrics(s.similarity, s.threshold, s.zero_distance, s.gospa_c, s.gospa_p)
         self.steps = 0
         self._done = False
@@ -188,59 +157,45 @@ class TrackingEnv(gym.Env):
         self._answered: tuple | None = None  # what render() draws: the frame the last tracks answer
         self._idf1: tuple[int, float | None] = (0, None)
         obs = self.observe()
-        if self.recording is None:
-            seen = self.truth.visibility > 0
-            init_ids, init_boxes = self.truth.ids[seen].copy(), self.truth.boxes[seen].copy()
-            rate, length = float(self.metadata["render_fps"]), None
-        else:
-            init_ids, init_boxes, _ = self.recording.scoring(0, np.zeros((0, 4)))
-            rate, length = self.recording.info.frame_rate, len(self.recording)
-        info = {"frame_index": 0, "init_ids": init_ids, "init_boxes": init_boxes,
-                "image_size": (sc.render.width, sc.render.height), "frame_rate": rate, "length": length}
+        init_ids, init_boxes = self.source.first_targets()
+        info = {"frame_index": 0, "init_ids": init_ids, "init_boxes": init_boxes, "image_size": self.source.image_size,
+                "frame_rate": self.source.frame_rate, "length": self.source.length}
         if self._viewer:
             self.render()
         return obs, info
 
     def _reconfigure(self, config: Mapping):
         overrides = scn.merge(self._overrides, scn.expand_dotted(config))
-        new = self._load(overrides)
-        changed = [k for k in _SPACE_KEYS if _get(new, k) != _get(self.scenario, k)]
+        new = open_source(self._what, overrides, self._benchmark, self._recorded)
+        changed = [k for k in _SPACE_KEYS if _get(new.config, k) != _get(self.config, k)]
         if changed:
             raise ValueError(f"reset(options={{'config': ...}}) cannot change {', '.join(changed)}: the observation and "
                              "action spaces are fixed when the env is made; pass them to gym.make(..., config=...) instead")
-        self.scenario = new
+        self.source, self._overrides = new, overrides
 
     def step(self, action):
         if self._done:
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self.remember_tracks(ids, boxes)
-        everyone = None
-        if self.recording is None:
-            t = self.truth
-            scored = t.visibility >= self.scenario.scoring.min_visibility
-            gt_ids, gt_boxes, kept, everyone = t.ids[scored], t.boxes[scored], slice(None), (t.ids, t.boxes, t.visibility)
-        else:
-            gt_ids, gt_boxes, kept = self.recording.scoring(self.steps, boxes)
+        gt_ids, gt_boxes, kept, everyone = self.source.scored_truth(boxes)
         stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept], everyone)
-        reward = self._reward(stats) if self.recording is None or self.recording.scored else 0.0
-        if self.recording is None:
-            self.world.step()
-            self.renderer.camera.advance(self.world)
+        reward = self._reward(stats) if self.scored else 0.0
+        self.source.advance()
         self.steps += 1
         obs = self.observe()
-        terminated = bool(self.world.finished) if self.recording is None else self.steps >= len(self.recording)
-        truncated = bool(self.steps >= self.scenario.env.max_steps and not terminated)
+        terminated = self.source.finished
+        truncated = bool(self.steps >= self.config.env.max_steps and not terminated)
         self._done = terminated or truncated
         info = {"frame_index": self.steps, "frame": dict(vars(stats))}
-        if self._done and (self.recording is None or self.recording.scored):
+        if self._done and self.scored:
             info["metrics"] = self.metrics.summary()
         if self._viewer:
             self.render()
         return obs, float(reward), terminated, truncated, info
 
     def _reward(self, stats: FrameStats) -> float:
-        s = self.scenario.scoring
+        s = self.config.scoring
         if s.reward_mode == "mota":
             return float(stats.tp - stats.fp - stats.idsw)
         if s.reward_mode == "gospa":
@@ -248,46 +203,25 @@ class TrackingEnv(gym.Env):
         return s.iou_weight * stats.similarity_sum - s.fp_weight * stats.fp - s.fn_weight * stats.fn
 
     def observe(self) -> dict[str, Any]:
-        """Render, measure the truth and detect for the world as it is now (after reset/step, or after `world.place`);
-        for a recorded sequence, read its current frame (after the last one: no detections and a black frame)."""
-        sc = self.scenario
-        want_frame = sc.env.obs_mode == "frame+detections" or sc.sensor.model == "foreground" or self.render_mode
-        if self.recording is not None:
-            self._read(bool(want_frame))
-        else:
-            frame, labels, boxes = self.renderer.render(self.world, draw_frame=bool(want_frame))
-            w = self.world
-            self.frame, self.labels = frame, labels
-            self.truth: Truth = measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group],
-                                        self.renderer.occluder_image_boxes(), self.renderer.occluder_depth)
-            self.detections: Detections = self.sensor.detect(self.truth, labels, frame)
-        rows, frame = self.detections.rows, self.frame
-        padded = np.zeros((sc.sensor.max_detections, 5), self.observation_space["detections"].dtype)
+        """The source's current frame as an observation (after reset/step, or after moving its targets by hand); it
+        keeps the frame's truth, detections and image for scoring and render()."""
+        c = self.config
+        want_frame = c.env.obs_mode == "frame+detections" or c.sensor.model == "foreground" or self.render_mode
+        self.truth, self.detections, self.frame = self.source.observe(bool(want_frame))
+        rows = self.detections.rows
+        padded = np.zeros((c.sensor.max_detections, 5), self.observation_space["detections"].dtype)
         padded[: len(rows)] = rows
         obs = {"detections": padded, "num_detections": np.int64(len(rows))}
-        if sc.env.obs_mode == "frame+detections":
-            obs = {"frame": frame, **obs}
+        if c.env.obs_mode == "frame+detections":
+            obs = {"frame": self.frame, **obs}
         return obs
-
-    def _read(self, want_frame: bool) -> None:
-        """The recorded sequence's current frame: truth, detections and (if wanted) the image."""
-        rec, k = self.recording, self.steps
-        self.truth = rec.truth(k)
-        self.frame = rec.image(k) if want_frame and rec.has_images and k < len(rec) else None
-        if want_frame and self.frame is None:  # past the end, or a sequence without images being rendered
-            self.frame = np.zeros((self.scenario.render.height, self.scenario.render.width, 3), np.uint8)
-        if self.sensor is not None:  # the twin: the synthetic detector on the recorded people
-            self.detections = self.sensor.detect(self.truth)
-        else:
-            rows = rec.detections(k)
-            self.detections = Detections(rows, np.full(len(rows), -1, np.int64))
 
     # ------------------------------------------------------------ actions
 
     def validate_action(self, action) -> tuple[np.ndarray, np.ndarray]:
         """The action's tracks as (ids int64 (n,), boxes float32 (n, 4)), or an ActionError saying what is wrong. Boxes
         are checked as float32, the dtype they are scored and drawn in, against the action space's bounds."""
-        nt = self.scenario.env.max_tracks
+        nt = self.config.env.max_tracks
         if not isinstance(action, Mapping) or not {"ids", "boxes"} <= set(action):
             raise ActionError("action must be a dict with 'ids' and 'boxes' (and 'num_tracks' when padded), "
                               f"got {type(action).__name__}" + (f" with keys {sorted(action)}" if isinstance(action, Mapping) else ""))
@@ -397,8 +331,9 @@ class TrackingEnv(gym.Env):
             self._viewer.close()
 
 
-def _get(sc: scn.Scenario, dotted: str):
-    obj = sc
+def _get(config, dotted: str):
+    """The value of a dotted key in a configuration, or None where it has no such key (a sequence has no render.*)."""
+    obj = config
     for part in dotted.split("."):
-        obj = getattr(obj, part)
+        obj = getattr(obj, part, None)
     return obj

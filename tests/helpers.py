@@ -44,7 +44,7 @@ def placed(sc: scenario.Scenario, positions, seed=0) -> TrackingEnv:
     """An env reset on `sc` with its targets moved to `positions` and the observation recomputed."""
     env = TrackingEnv(sc)
     env.reset(seed=seed)
-    env.world.place(np.asarray(positions, float))
+    env.source.world.place(np.asarray(positions, float))
     env.observe()
     return env
 

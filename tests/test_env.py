@@ -97,8 +97,8 @@ def test_an_episode_without_frames_never_draws_its_looks_and_they_are_the_same_w
     for _ in range(5):
         early.step(NO_TRACKS)
         late.step(NO_TRACKS)
-    assert "_looks" not in vars(late.renderer) and "_looks" in vars(early.renderer)
-    np.testing.assert_array_equal(late.renderer.render(late.world)[0], early.frame)
+    assert "_looks" not in vars(late.source.renderer) and "_looks" in vars(early.source.renderer)
+    np.testing.assert_array_equal(late.source.renderer.render(late.source.world)[0], early.frame)
 
 
 def test_detections_mode_sees_the_same_world_without_frames():

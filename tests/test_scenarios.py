@@ -22,7 +22,7 @@ def run(key, steps, **kwargs):
     for _ in range(steps):
         frame = obs.get("frame")
         out.append((env.truth, env.detections, None if frame is None else float(frame.mean()),
-                    env.renderer.camera.offset.copy()))
+                    env.source.renderer.camera.offset.copy()))
         obs, _, term, trunc, _ = env.step(NO_TRACKS)
         if term or trunc:
             break
@@ -36,7 +36,7 @@ RESOLUTION = {"crossing": (384, 288), "soccer": (720, 576), "umbrellas": (768, 5
 @pytest.mark.parametrize("key", sorted(RESOLUTION))
 def test_resolution_and_fifty_steps(key):
     env, rec = run(key, 50)
-    assert (env.scenario.render.width, env.scenario.render.height) == RESOLUTION[key]
+    assert (env.config.render.width, env.config.render.height) == RESOLUTION[key]
     assert len(rec) == 50
 
 
@@ -47,21 +47,21 @@ def test_crossing_two_walkers_are_cut_by_the_pole_hidden_by_the_sign_and_fragmen
     assert any(len(t.pieces) for t, *_ in rec)                      # the pole cuts a walker in two
     assert any((t.visibility < 0.3).any() for t, *_ in rec)          # the sign (or the other walker) hides one
     assert any(len(d.rows) > len(t) for t, d, *_ in rec)             # the foreground detector fragments
-    assert env.world.standing
+    assert env.source.world.standing
 
 
 def test_soccer_many_alike_players_merge_in_the_foreground():
     env, rec = run("soccer", 100)
     assert all(len(t) == 22 for t, *_ in rec)
-    colors = env.world.color.astype(float)
+    colors = env.source.world.color.astype(float)
     assert np.ptp(colors[:11], axis=0).max() < 40                       # a team shares its kit
     assert any(len(d.rows) < len(t) for t, d, *_ in rec)             # touching players become one blob
 
 
 def test_umbrellas_same_colour_different_texture_on_a_shaking_camera():
     env, rec = run("umbrellas", 220, obs_mode="detections")
-    assert (env.world.color[0] == env.world.color[1]).all()
-    assert env.world.texture_of_group.tolist() == [1, 2]
+    assert (env.source.world.color[0] == env.source.world.color[1]).all()
+    assert env.source.world.texture_of_group.tolist() == [1, 2]
     offsets = np.array([o for *_, o in rec])
     assert np.ptp(offsets, axis=0).min() >= 2                           # the handheld camera shakes
     assert any((t.visibility < 0.9).any() for t, *_ in rec)          # the trunk hides an umbrella
@@ -71,7 +71,7 @@ def test_books_small_books_are_hidden_completely_and_carried_by_the_books_over_t
     env, rec = run("books", 400, obs_mode="detections")
     vis = np.array([t.visibility for t, *_ in rec])                  # (frames, 4): ids 1, 2 small, 3 large, 4 cover
     centres = np.array([t.boxes[:2, :2] + t.boxes[:2, 2:] / 2 for t, *_ in rec])
-    assert vis.shape == (400, 4) and env.world.shape_is_rect.all() and not env.world.carrier_id[2:].any()
+    assert vis.shape == (400, 4) and env.source.world.shape_is_rect.all() and not env.source.world.carrier_id[2:].any()
     hidden = vis[:, :2] < 0.05
     assert hidden.sum() >= 30                                         # complete occlusions are common
     for k in range(2):                                                # a hidden book moves with its carrier
@@ -90,12 +90,12 @@ def test_skating_camera_follows_fast_skaters():
     centres = np.array([(t.boxes[:, 0] + t.boxes[:, 2] / 2).mean() for t, *_ in rec])
     inside = (offsets[:, 0] > 0) & (offsets[:, 0] < 640 - 320)       # away from the rink's ends the camera keeps up
     assert inside.sum() > 20 and np.median(np.abs(centres[inside] - 160)) < 10
-    assert np.hypot(*env.world.vel.T).max() > 3
+    assert np.hypot(*env.source.world.vel.T).max() > 3
 
 
 def test_mot17_like_crowd_enters_by_borders_and_doors_in_dim_light():
     env, rec = run("mot17_like", 150)
-    assert len(rec[0][0]) == 15 and env.world.births > 5  # 11 walkers and 4 strollers to start with
+    assert len(rec[0][0]) == 15 and env.source.world.births > 5  # 11 walkers and 4 strollers to start with
     assert max(m for *_, m, _ in rec) < 90                             # dim
     assert np.mean([(t.visibility < 1).sum() for t, *_ in rec]) > 0.5   # people occlude each other
     false = np.concatenate([d.sources == CLUTTER for _, d, *_ in rec])

@@ -11,7 +11,7 @@ from mtt_sim.sim import sensor as sensor_mod
 from mtt_sim.sim.config import SensorConfig
 from mtt_sim.sim.sensor import CLUTTER, components, detection_probabilities
 from mtt_sim.env import TrackingEnv
-from mtt_sim.metrics import box_iou
+from mtt_sim.boxes import box_iou
 from mtt_sim.sim.truth import Truth
 
 
@@ -61,9 +61,9 @@ def test_random_fragmentation_splits_into_two_or_three_boxes_inside_the_target()
 
 def test_clutter_counts_follow_the_poisson_mean():
     sc = tiny(sensor={"clutter_rate": 3.0})
-    s = sensor_mod.SyntheticSensor(sc, np.random.default_rng(0))
+    s = sensor_mod.make_sensor(sc, np.random.default_rng(0), None)
     env = placed(sc, [[100.0, 50.0]])
-    counts = [(s.detect(env.truth, env.labels).sources == CLUTTER).sum() for _ in range(2000)]
+    counts = [(s.detect(env.truth, env.source.labels).sources == CLUTTER).sum() for _ in range(2000)]
     assert abs(np.mean(counts) - 3.0) < 0.15  # standard error 0.039
     assert abs(np.var(counts) - 3.0) < 0.4   # Poisson: variance = mean
 
@@ -140,7 +140,7 @@ def frames_of(sensor_keys, n_frames, boxes=((80.0, 20.0, 20.0, 40.0),), seed=0, 
     n = len(boxes)
     truth = Truth(ids=np.arange(1, n + 1), boxes=boxes, visibility=np.ones(n) if visibility is None else visibility,
                   visible_boxes=boxes, depth=np.zeros(n), labels=np.arange(1, n + 1), pieces=np.zeros((0, 5)))
-    s = sensor_mod.SyntheticSensor(tiny(sensor={"box_noise": 0.0, **sensor_keys}), np.random.default_rng(seed))
+    s = sensor_mod.make_sensor(tiny(sensor={"box_noise": 0.0, **sensor_keys}), np.random.default_rng(seed), None)
     return [s.detect(truth) for _ in range(n_frames)]
 
 

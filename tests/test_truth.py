@@ -39,7 +39,7 @@ def test_target_leaving_the_image_is_clipped_and_drops_out_when_gone():
     env = placed(tiny([still(shape="rect")]), [[190.0, 50.0]])
     np.testing.assert_allclose(env.truth.boxes[0], [170, 30, 30, 40])
     assert env.truth.visibility[0] == 1.0
-    env.world.place([[400.0, 50.0]])
+    env.source.world.place([[400.0, 50.0]])
     env.observe()
     assert len(env.truth) == 0
 

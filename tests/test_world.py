@@ -167,11 +167,11 @@ def carry_scene(carry_frames: int):
 def test_a_completely_covered_target_rides_with_its_cover_for_carry_frames_then_is_left(carry_frames):
     env = TrackingEnv(carry_scene(carry_frames))
     env.reset(seed=0)
-    start = env.world.pos[0].copy()
+    start = env.source.world.pos[0].copy()
     path = []
     for _ in range(120):
         env.step(NO_TRACKS)
-        path.append(env.world.pos[0].copy())
+        path.append(env.source.world.pos[0].copy())
     moved = np.array(path) - start
     if not carry_frames:
         assert np.abs(moved).max() < 1e-9                      # covered, but it stays put
@@ -179,4 +179,4 @@ def test_a_completely_covered_target_rides_with_its_cover_for_carry_frames_then_
     steps = np.flatnonzero(np.diff(moved[:, 0]) > 1.0)         # frames in which it moved with its cover
     assert len(steps) == carry_frames and np.ptp(np.diff(steps)) == 0   # one run of carry_frames frames
     assert moved[-1, 0] == pytest.approx(2.0 * carry_frames, abs=2.5) and abs(moved[-1, 1]) < 1e-6
-    assert env.world.carrier_id[0] == 0                        # left, touching again
+    assert env.source.world.carrier_id[0] == 0                        # left, touching again

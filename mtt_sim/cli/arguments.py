@@ -13,6 +13,7 @@ import os
 import tomllib
 from pathlib import Path
 
+from mtt_sim import sources
 from mtt_sim.sim import scenario
 
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
@@ -88,7 +89,7 @@ def parse_seeds(text: str) -> list[int]:
 def scenario_key(text: str) -> str:
     """A scenario as the loader names it (a key, an env id, a .toml file or a sequence folder)."""
     try:
-        return str(scenario.resolve(text))
+        return str(sources.resolve(text))
     except scenario.ConfigError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
 
@@ -207,7 +208,7 @@ def loaded(scenarios: list[str], config: dict, argument: str = "--config", confi
     for sc in scenarios:
         for extra in configs:
             try:
-                scenario.load(sc, {**config, **extra})
+                sources.open_source(sc, {**config, **extra})
             except scenario.ConfigError as err:
                 raise UsageError(argument, str(err)) from None
 

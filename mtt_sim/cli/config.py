@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from mtt_sim.cli.arguments import CONFIG_HELP, SCENARIO_HELP, add_overrides, episode_overrides, loaded, scenario_key
+from mtt_sim import sources
 from mtt_sim.sim import scenario
 
 
@@ -19,7 +20,7 @@ def run(args) -> int:
     overrides = episode_overrides(args)
     if args.scenario:
         loaded([args.scenario], overrides)
-        print(json.dumps(scenario.to_mapping(scenario.load(args.scenario, overrides)), indent=2))
+        print(json.dumps(scenario.to_mapping(sources.open_source(args.scenario, overrides).config), indent=2))
     else:
         print(scenario.reference_table())
     return 0

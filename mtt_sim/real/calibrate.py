@@ -35,8 +35,7 @@ from scipy.special import expit, logit, logsumexp
 from mtt_sim.sim import scenario as scn
 from mtt_sim.real import truth_statistics as scene
 from mtt_sim.metrics import box_iou
-from mtt_sim.sim.sensor import SyntheticSensor
-from mtt_sim.real.sequence import Recording
+from mtt_sim.real.sequence import Recording, SequenceConfig, twin_sensor
 from mtt_sim.sim.truth import Truth, overlapping_pairs
 
 MATCH_IOU = 0.5     # a true detection
@@ -398,8 +397,9 @@ def read(folder: str | Path) -> Source:
 
 def twin_detections(source: Source, sensor: dict, seed: int) -> list[np.ndarray]:
     """What the synthetic detector with these keys reports on the sequence's people, frame by frame."""
-    sc = source.recording.scenario({"sensor": {**sensor, "model": "synthetic"}, "env": {"obs_mode": "detections"}})
-    s = SyntheticSensor(sc, np.random.default_rng(seed))
+    rec = source.recording
+    cfg = scn.from_mapping({"sensor": {**sensor, "model": "synthetic"}}, str(rec.folder), SequenceConfig).sensor
+    s = twin_sensor(cfg, rec.image_size, np.random.default_rng(seed))
     return [s.detect(t).rows.astype(float) for t in source.truths]
 
 

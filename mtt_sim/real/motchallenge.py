@@ -22,7 +22,7 @@ from tqdm import tqdm
 
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from mtt_sim.metrics import EpisodeMetrics
-from mtt_sim.sim.scenario import is_sequence
+from mtt_sim.real.layout import is_sequence
 from mtt_sim.real.sequence import Recording, by_frame, check_frames, read_rows
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
@@ -40,7 +40,7 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
     obs, first = env.reset(seed=seed)
     if "frame" in obs:
         (out / "img1").mkdir(exist_ok=True)
-    sc = env.scenario
+    sc = env.config
     limit = steps or sc.env.max_steps
     gt_rows, det_rows = [], []
     bar = tqdm(total=limit, unit="frame", desc=f"exporting {out}", disable=not progress)
@@ -61,8 +61,8 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
         if terminated or truncated or frame >= limit:
             break
     bar.close()
-    if recorded and env.recording.scored:  # the recording's own ground truth, its lines as written, cut to the frames
-        gt = env.recording.folder / "gt" / "gt.txt"
+    if recorded and env.scored:  # the recording's own ground truth, its lines as written, cut to the frames
+        gt = env.source.folder / "gt" / "gt.txt"
         frames = read_rows(gt, 7)[:, 0]
         lines = [line for line in gt.read_text().splitlines() if line.strip()]
         gt_rows = [line for line, f in zip(lines, frames) if f <= frame]
@@ -72,9 +72,10 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
     _write_rows(out / "det" / "det.txt", det_rows)
     info = configparser.ConfigParser()
     info.optionxform = str
-    name = f"{env.recording.info.name}-twin" if recorded else sc.name
+    name = f"{env.source.info.name}-twin" if recorded else sc.name
+    width, height = env.source.image_size
     info["Sequence"] = {"name": f"{name}-seed{seed}", "imDir": "img1", "frameRate": f"{first['frame_rate']:g}",
-                        "seqLength": str(frame), "imWidth": str(sc.render.width), "imHeight": str(sc.render.height),
+                        "seqLength": str(frame), "imWidth": str(width), "imHeight": str(height),
                         "imExt": ".jpg"}
     with (out / "seqinfo.ini").open("w") as f:
         info.write(f, space_around_delimiters=False)

@@ -9,8 +9,10 @@ a time when asked for. Ground truth is scored as TrackEval's MotChallenge2DBox s
 - MOT15: no classes; rows whose `considered` column is 0 are not scored.
 The truth the env shows holds the people (classes a person detector fires on) with their visible fraction: the
 visibility column where the benchmark has one (MOT16/17/20; not used for scoring, as in TrackEval), else measured from
-box overlaps (the box whose bottom edge is lower is nearer). With `sensor.model = "synthetic"` the env replays that
-truth through the synthetic detector (a digital twin of the sequence) instead of reading det/det.txt.
+box overlaps (the box whose bottom edge is lower is nearer). With `sensor.model = "synthetic"` that truth is replayed
+through the synthetic detector (a digital twin of the sequence) instead of reading det/det.txt.
+
+`Recording` implements `mtt_sim.sources.Source`, the interface a simulated scene implements too.
 """
 
 from __future__ import annotations
@@ -24,9 +26,11 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from mtt_sim.sim import scenario as scn
-from mtt_sim.sim.scenario import is_sequence
 from mtt_sim.metrics import EPS, box_iou
+from mtt_sim.real.layout import is_sequence
+from mtt_sim.sim import scenario as scn
+from mtt_sim.sim.config import EnvConfig, GroupConfig, ScoringConfig, SensorConfig, table
+from mtt_sim.sim.sensor import Detections, SyntheticSensor
 from mtt_sim.sim.truth import Truth, occlusion_visibility
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20")
@@ -35,6 +39,16 @@ DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7
 PEOPLE = (1, 2, 7, 8, 12)  # pedestrian, person on vehicle, static person, distractor, reflection
 VALID_CLASSES = range(1, 14)
 FRAME_RATE = 30.0  # where seqinfo.ini gives none
+
+
+@dataclass(frozen=True)
+class SequenceConfig:
+    """The configuration a recorded sequence runs with: the env's, the scoring's and (for its twin) the detector's
+    tables; the image size, length and frame rate come from the sequence."""
+
+    env: EnvConfig = table(EnvConfig, "the Gym face")
+    scoring: ScoringConfig = table(ScoringConfig, "scoring and rewards")
+    sensor: SensorConfig = table(SensorConfig, "the detector: 'recorded' reads det/det.txt, 'synthetic' is the twin")
 
 
 @dataclass(frozen=True)
@@ -51,9 +65,13 @@ class SequenceInfo:
 
 
 class Recording:
-    """One sequence's detections, ground truth and frames, frame by frame (frame k = file frame k + 1)."""
+    """One sequence's detections, ground truth and frames, frame by frame (frame k = file frame k + 1), and the source
+    that replays them: `reset`, then `observe` and `advance` frame by frame. `overrides` take env.*, scoring.* and
+    sensor.* keys; sensor.model = "synthetic" replays the people through the synthetic detector (the twin)."""
 
-    def __init__(self, folder, benchmark: str | None = None):
+    detection_dtype = np.float64  # detections are handed on as written
+
+    def __init__(self, folder, benchmark: str | None = None, overrides: Mapping | None = None):
         self.folder = Path(folder)
         if not is_sequence(self.folder):
             raise scn.ConfigError(f"{folder}: not a MOTChallenge sequence folder (expected seqinfo.ini, det/det.txt or "
@@ -75,6 +93,11 @@ class Recording:
         counts = np.diff(self._det[1])
         self.max_detections = int(counts.max()) if len(counts) else 0
         self.det_range = (det[:, 2:7].min(axis=0), det[:, 2:7].max(axis=0)) if len(det) else (np.zeros(5), np.zeros(5))
+        self.config = self._configure(overrides or {})
+        self.image_size = (self.info.width, self.info.height)
+        self.frame_rate, self.length = self.info.frame_rate, self.info.length
+        self.sensor: SyntheticSensor | None = None
+        self.k = 0
 
     def __len__(self) -> int:
         return self.info.length
@@ -120,10 +143,10 @@ class Recording:
                              f"{self.info.width}x{self.info.height} (seqinfo.ini)")
         return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
 
-    def scenario(self, overrides: Mapping | None = None) -> scn.Scenario:
-        """The configuration the env runs this sequence with: image size, length and detection rows from the data;
-        `env.*` and `scoring.*` keys can be overridden, and `sensor.*` keys for the synthetic detector (the twin)."""
-        overrides = scn.expand_dotted(overrides or {})
+    def _configure(self, overrides: Mapping) -> SequenceConfig:
+        """The configuration this sequence runs with: detection rows and episode length from the data; `env.*` and
+        `scoring.*` keys can be overridden, and `sensor.*` keys for the synthetic detector (the twin)."""
+        overrides = scn.expand_dotted(overrides)
         other = sorted(set(overrides) - {"env", "scoring", "sensor"})
         if other:
             raise scn.ConfigError(f"{self.folder}: a recorded sequence takes only env.*, scoring.* and sensor.* "
@@ -141,13 +164,63 @@ class Recording:
         if obs_mode == "frame+detections" and not self.has_images:
             raise scn.ConfigError(f"{self.folder}: env.obs_mode = 'frame+detections', but the sequence has no "
                                   f"{self.info.image_dir}/ folder of frames; use obs_mode='detections'")
-        i = self.info
-        raw = {"name": "Replay", "description": f"the recorded sequence {i.name} ({self.folder})",
-               "render": {"width": i.width, "height": i.height, "background": "flat"},
-               "sensor": {"model": "recorded", "max_detections": max(1, self.max_detections)} if model == "recorded"
+        raw = {"sensor": {"model": "recorded", "max_detections": max(1, self.max_detections)} if model == "recorded"
                else {},
-               "env": {"max_steps": i.length, "obs_mode": "frame+detections" if self.has_images else "detections"}}
-        return scn.from_mapping(scn.merge(raw, overrides), str(self.folder))
+               "env": {"max_steps": self.info.length,
+                       "obs_mode": "frame+detections" if self.has_images else "detections"}}
+        return scn.from_mapping(scn.merge(raw, overrides), str(self.folder), SequenceConfig)
+
+    # ------------------------------------------------------------ the source
+
+    def detection_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Boxes in the image and confidences in the detector's range, widened to the extremes of det.txt where its
+        rows are handed on as written (raw confidences included)."""
+        (w, h), s = self.image_size, self.config.sensor
+        low = np.array([0, 0, 0, 0, min(s.conf_offset, 0.0)])
+        high = np.array([w, h, w, h, max(s.conf_offset + s.conf_scale, 0.0)])
+        if s.model == "recorded":
+            low, high = np.minimum(low, np.floor(self.det_range[0])), np.maximum(high, np.ceil(self.det_range[1]))
+        return low, high
+
+    def reset(self, world_rng: np.random.Generator, render_rng: np.random.Generator,
+              sensor_rng: np.random.Generator) -> None:
+        """Back to the first frame; the twin's detector starts afresh from `sensor_rng` (the others are unused)."""
+        self.k = 0
+        self.sensor = twin_sensor(self.config.sensor, self.image_size, sensor_rng) \
+            if self.config.sensor.model == "synthetic" else None
+
+    def observe(self, want_frame: bool) -> tuple[Truth, Detections, np.ndarray | None]:
+        """The current frame's truth, detections and (if wanted) image: black past the end or without images."""
+        k = self.k
+        truth = self.truth(k)
+        frame = self.image(k) if want_frame and self.has_images and k < len(self) else None
+        if want_frame and frame is None:
+            frame = np.zeros((self.info.height, self.info.width, 3), np.uint8)
+        if self.sensor is not None:
+            return truth, self.sensor.detect(truth), frame
+        rows = self.detections(k)
+        return truth, Detections(rows, np.full(len(rows), -1, np.int64)), frame
+
+    def first_targets(self) -> tuple[np.ndarray, np.ndarray]:
+        """Ids and boxes of the scored targets of the first frame (for trackers initialised by hand)."""
+        return self.scoring(0, np.zeros((0, 4)))[:2]
+
+    def scored_truth(self, track_boxes: np.ndarray):
+        """`scoring` of the current frame, and no view of the hidden targets (a sequence has no occlusion windows)."""
+        return *self.scoring(self.k, track_boxes), None
+
+    def advance(self) -> None:
+        self.k += 1
+
+    @property
+    def finished(self) -> bool:
+        return self.k >= len(self)
+
+
+def twin_sensor(cfg: SensorConfig, image_size: tuple[int, int], rng: np.random.Generator) -> SyntheticSensor:
+    """The synthetic detector on a recorded sequence's people (its twin); clutter takes the size of a default target
+    when nobody is in view."""
+    return SyntheticSensor(cfg, image_size, np.array([GroupConfig().size], float), rng)
 
 
 def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:

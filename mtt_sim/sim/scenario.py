@@ -193,12 +193,13 @@ def _check_budget(sc: Scenario, where: str) -> Scenario:
     return sc
 
 
-def from_mapping(raw: Mapping, where: str = "<config>") -> Scenario:
-    """Build and validate a Scenario from a nested mapping (as read from TOML)."""
+def from_mapping(raw: Mapping, where: str = "<config>", schema: type = Scenario):
+    """Build and validate a Scenario (or another schema of config tables, such as a recorded sequence's) from a nested
+    mapping (as read from TOML)."""
     if not isinstance(raw, Mapping):
         raise ConfigError(f"{where}: expected a table of scenario keys, got {type(raw).__name__}")
-    raw = _with_preset(raw, where)
-    return _check_references(_build(Scenario, raw, where), where)
+    built = _build(schema, _with_preset(raw, where), where)
+    return _check_references(built, where) if schema is Scenario else built
 
 
 # ---------------------------------------------------------------- files and overrides
@@ -228,21 +229,9 @@ def shipped_names() -> dict[str, str]:
             for p in sorted(scenario_dir().iterdir(), key=lambda p: p.name) if p.name.endswith(".toml")}
 
 
-def is_sequence(path) -> bool:
-    """Whether `path` is a folder laid out as a MOTChallenge sequence (seqinfo.ini, det/det.txt or gt/gt.txt)."""
-    p = Path(path)
-    return p.is_dir() and any((p / f).is_file() for f in ("seqinfo.ini", "det/det.txt", "gt/gt.txt"))
-
-
 def resolve(name: str | Path) -> str | Path:
-    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml file or a
-    recorded sequence's folder is returned as a Path. An unknown name gets the list of keys and, for a near miss, a
-    suggestion."""
-    if Path(name).is_dir():
-        if not is_sequence(name):
-            raise ConfigError(f"{str(name)!r} is a folder but not a MOTChallenge sequence (no seqinfo.ini, det/det.txt "
-                              "or gt/gt.txt in it)")
-        return Path(name)
+    """The shipped key a user means, in any letter case or as its env id ("mtt_sim/Crossing-v0"); a .toml file is
+    returned as a Path. An unknown name gets the list of keys and, for a near miss, a suggestion."""
     if isinstance(name, Path) or str(name).endswith(".toml"):
         if not Path(name).is_file():
             raise ConfigError(f"scenario file {str(name)!r}: not found")
@@ -353,10 +342,6 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
     """Load a shipped scenario (by key), a TOML file or an existing Scenario, with optional overrides."""
     if isinstance(key_or_path, Scenario):
         raw, where = to_mapping(key_or_path), f"scenario {key_or_path.name}"
-    elif is_sequence(key_or_path):
-        from mtt_sim.real.sequence import Recording  # here: the recorded source builds on this module
-
-        return Recording(key_or_path).scenario(overrides)
     else:
         raw, where = load_raw(key_or_path)
     if overrides:

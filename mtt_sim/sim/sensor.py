@@ -157,10 +157,11 @@ def astray(boxes: np.ndarray, spread: float, band: tuple[float, float], rng: np.
 class Sensor:
     """What both detector models share: clutter, confidences and the observation limits."""
 
-    def __init__(self, sc: Scenario, rng: np.random.Generator):
-        self.cfg, self.rng = sc.sensor, rng
-        self.size = (sc.render.width, sc.render.height)
-        self.nominal = np.array([g.size for g in sc.groups], float)
+    def __init__(self, cfg: SensorConfig, image_size: tuple[int, int], nominal: np.ndarray, rng: np.random.Generator):
+        """`nominal`: (k, 2) target sizes that clutter takes when nobody is in view."""
+        self.cfg, self.rng = cfg, rng
+        self.size = tuple(image_size)
+        self.nominal = nominal
 
     def _confidence(self, mean: np.ndarray, false: np.ndarray) -> np.ndarray:
         """Beta draws of the given means (conf_spread, or conf_false_spread for false ones), offset and scaled."""
@@ -257,8 +258,8 @@ class SyntheticSensor(Sensor):
     """Detections made from the truth and the label map (no image processing); without a label map (a recorded
     sequence's ground truth) targets whose boxes overlap count as touching."""
 
-    def __init__(self, sc: Scenario, rng: np.random.Generator):
-        super().__init__(sc, rng)
+    def __init__(self, cfg: SensorConfig, image_size: tuple[int, int], nominal: np.ndarray, rng: np.random.Generator):
+        super().__init__(cfg, image_size, nominal, rng)
         self.memory, self.sites = _Memory(), _Sites()
 
     def detect(self, truth: Truth, labels: np.ndarray | None = None, frame: np.ndarray | None = None) -> Detections:
@@ -399,8 +400,9 @@ class SyntheticSensor(Sensor):
 class ForegroundSensor(Sensor):
     """Background subtraction against a running background model, morphology and connected components."""
 
-    def __init__(self, sc: Scenario, rng: np.random.Generator, background: np.ndarray):
-        super().__init__(sc, rng)
+    def __init__(self, cfg: SensorConfig, image_size: tuple[int, int], nominal: np.ndarray, rng: np.random.Generator,
+                 background: np.ndarray):
+        super().__init__(cfg, image_size, nominal, rng)
         self.model = cv2.cvtColor(background, cv2.COLOR_RGB2GRAY).astype(np.float32)
         self.open = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
         self.close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
@@ -439,6 +441,7 @@ def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.
 def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray | None) -> Sensor:
     """The scenario's detector; `background` (an empty frame, needed by the foreground model only) seeds the
     foreground model."""
+    parts = (sc.sensor, (sc.render.width, sc.render.height), np.array([g.size for g in sc.groups], float), rng)
     if sc.sensor.model == "foreground":
-        return ForegroundSensor(sc, rng, background)
-    return SyntheticSensor(sc, rng)
+        return ForegroundSensor(*parts, background)
+    return SyntheticSensor(*parts)

@@ -1,0 +1,84 @@
+"""A simulated scene as the env's source: the world moves, the renderer draws, the sensor detects.
+
+It implements `mtt_sim.sources.Source`, the interface a recorded sequence implements too.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mtt_sim.sim.config import Scenario
+from mtt_sim.sim.render import Renderer
+from mtt_sim.sim.sensor import Detections, Sensor, make_sensor
+from mtt_sim.sim.truth import Truth, measure
+from mtt_sim.sim.world import World
+
+FRAME_RATE = 25.0  # frames per second of simulated video
+
+
+class Scene:
+    """One scenario's world, renderer and detector, rebuilt at every reset from the generators it is given."""
+
+    length = None  # a scene ends when its world does (or at env.max_steps)
+    scored = True
+    frame_rate = FRAME_RATE
+    detection_dtype = np.float32
+
+    def __init__(self, scenario: Scenario):
+        self.config = scenario
+        self.image_size = (scenario.render.width, scenario.render.height)
+        self.world: World | None = None
+        self.renderer: Renderer | None = None
+        self.sensor: Sensor | None = None
+        self.truth: Truth | None = None
+        self.labels: np.ndarray | None = None
+
+    def detection_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Boxes lie in the image; confidences in conf_offset + [0, conf_scale] (and zero for padding rows)."""
+        (w, h), s = self.image_size, self.config.sensor
+        return (np.array([0, 0, 0, 0, min(s.conf_offset, 0.0)]),
+                np.array([w, h, w, h, max(s.conf_offset + s.conf_scale, 0.0)]))
+
+    def reset(self, world_rng: np.random.Generator, render_rng: np.random.Generator,
+              sensor_rng: np.random.Generator) -> None:
+        sc = self.config
+        self.world = World(sc, world_rng)
+        self.renderer = Renderer(sc, render_rng)
+        if sc.render.camera == "follow":
+            self.renderer.camera.follow(self.world)
+        empty = self.renderer.render(self.world, show_targets=False)[0] if sc.sensor.model == "foreground" else None
+        self.sensor = make_sensor(sc, sensor_rng, empty)
+
+    def observe(self, want_frame: bool) -> tuple[Truth, Detections, np.ndarray | None]:
+        """Render the world as it is now (after reset, advance or `world.place`), measure its truth and detect."""
+        frame, self.labels, boxes = self.renderer.render(self.world, draw_frame=want_frame)
+        self.truth = self.measure(self.labels, boxes)
+        return self.truth, self.sensor.detect(self.truth, self.labels, frame), frame
+
+    def measure(self, labels: np.ndarray, boxes: np.ndarray) -> Truth:
+        """The truth of the frame just rendered: the targets' image boxes, what of them the label map shows, and who
+        covers whom."""
+        w = self.world
+        return measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group], self.renderer.occluder_image_boxes(),
+                       self.renderer.occluder_depth)
+
+    def first_targets(self) -> tuple[np.ndarray, np.ndarray]:
+        """Ids and boxes of the targets visible in the first frame (for trackers initialised by hand)."""
+        seen = self.truth.visibility > 0
+        return self.truth.ids[seen].copy(), self.truth.boxes[seen].copy()
+
+    def scored_truth(self, track_boxes: np.ndarray):
+        """The current frame's scored ground truth (ids, boxes), which tracks are scored, and everyone in view (ids,
+        boxes, visibility: the occlusion windows need the hidden targets too)."""
+        t = self.truth
+        scored = t.visibility >= self.config.scoring.min_visibility
+        return t.ids[scored], t.boxes[scored], slice(None), (t.ids, t.boxes, t.visibility)
+
+    def advance(self) -> None:
+        self.world.step()
+        self.renderer.camera.advance(self.world)
+
+    @property
+    def finished(self) -> bool:
+        """No target is alive and none can be born any more."""
+        return bool(self.world.finished)

@@ -1,0 +1,87 @@
+"""Where each step's ground truth, detections and frame come from: a simulated scene or a recorded sequence.
+
+Both implement `Source`; `TrackingEnv` holds one and never asks which kind it is. `open_source` is the one place that
+decides, from what the user named: a shipped scenario key, a scenario TOML file, an existing `Scenario`, or a
+MOTChallenge sequence folder (replayed as recorded, or through the synthetic detector: its digital twin).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Mapping, Protocol
+
+import numpy as np
+
+from mtt_sim.real.layout import is_sequence
+from mtt_sim.sim import scenario
+from mtt_sim.sim.config import ConfigError, Scenario
+
+if TYPE_CHECKING:
+    from mtt_sim.real.sequence import Recording, SequenceConfig
+    from mtt_sim.sim.scene import Scene
+    from mtt_sim.sim.sensor import Detections
+    from mtt_sim.sim.truth import Truth
+
+
+class Source(Protocol):
+    """What the env needs of a source: a few facts, then frame by frame the truth, detections and image."""
+
+    config: Scenario | SequenceConfig  # its env.*, scoring.* and sensor.* tables (a scenario has more)
+    image_size: tuple[int, int]        # width, height in pixels
+    frame_rate: float                  # frames per second
+    length: int | None                 # frames; None where the source ends when its world does
+    scored: bool                       # whether there is ground truth to score against
+    detection_dtype: type              # of the observation's detection rows
+
+    def detection_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lowest and highest values of a detection row (x, y, w, h, confidence)."""
+
+    def reset(self, world_rng: np.random.Generator, render_rng: np.random.Generator,
+              sensor_rng: np.random.Generator) -> None:
+        """Start over at the first frame, drawing from these independent generators."""
+
+    def observe(self, want_frame: bool) -> tuple[Truth, Detections, np.ndarray | None]:
+        """The current frame's ground truth (everyone in view), detections and, if wanted, RGB image."""
+
+    def first_targets(self) -> tuple[np.ndarray, np.ndarray]:
+        """Ids and boxes of the targets of the first frame, for trackers initialised by hand."""
+
+    def scored_truth(self, track_boxes: np.ndarray) -> tuple:
+        """The current frame's scored ground-truth ids and boxes, which of these tracks are scored (a mask or a
+        slice), and everyone in view (ids, boxes, visibility) for the occlusion windows, or None."""
+
+    def advance(self) -> None:
+        """Move on to the next frame."""
+
+    @property
+    def finished(self) -> bool:
+        """Whether the episode is over (nothing left to track, or past the last frame)."""
+
+
+def resolve(name: str | os.PathLike) -> str | Path:
+    """What a user named: a shipped scenario key (in any case or as its env id), a .toml file or a sequence folder
+    (both as Paths); an error naming the problem otherwise."""
+    if Path(name).is_dir():
+        if not is_sequence(name):
+            raise ConfigError(f"{str(name)!r} is a folder but not a MOTChallenge sequence (no seqinfo.ini, det/det.txt "
+                              "or gt/gt.txt in it)")
+        return Path(name)
+    return scenario.resolve(name)
+
+
+def open_source(what: str | os.PathLike | Scenario, overrides: Mapping | None = None, benchmark: str | None = None,
+                recorded: bool = False) -> Scene | Recording:
+    """The source `what` names (`recorded`: it must be a sequence folder), configured with `overrides` (nested or
+    dotted keys); `benchmark` (MOT15/16/17/20) sets a sequence's scoring rules instead of guessing them from its name
+    and columns."""
+    # the sources are imported here, when one is opened: naming one (`resolve`) stays cheap for the command line
+    if recorded or (not isinstance(what, Scenario) and is_sequence(what)):
+        from mtt_sim.real.sequence import Recording
+
+        return Recording(what, benchmark, overrides)
+    if benchmark is not None:
+        raise ValueError(f"benchmark={benchmark!r} applies to recorded sequences, not to the scenario {what!r}")
+    from mtt_sim.sim.scene import Scene
+
+    return Scene(scenario.load(what, overrides))
