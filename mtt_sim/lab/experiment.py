@@ -14,7 +14,6 @@ import itertools
 import json
 import math
 import re
-import time
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
 
@@ -25,6 +24,7 @@ from tqdm import tqdm
 from mtt_sim import trackers
 
 from mtt_sim.lab import pool
+from mtt_sim.lab.episode import Episode
 from mtt_sim.env import TrackingEnv
 from mtt_sim.metrics import METRICS, PER_TARGET
 from mtt_sim.real.motchallenge import write_results
@@ -33,44 +33,23 @@ from mtt_sim.show.overlay import VideoWriter
 BACKENDS = ("local", "ray")
 
 
-class _Episode:
-    """One tracker running on its own env: the agent, the env, the tracks it reported and its timers."""
+def _episode(scenario: str, spec: str, seed: int, config: Mapping | None, steps: int | None, render: bool,
+             scale: int) -> Episode:
+    """Tracker `spec` on its own env of `scenario`, reset with `seed` (frames in its observations if it reads them)."""
+    agent = trackers.make(spec)
+    env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if render else None,
+                      obs_mode="frame+detections" if agent.needs_frame else "detections", render_scale=scale)
+    return Episode(env, seed, agent, steps)
 
-    def __init__(self, scenario: str, tracker: str, seed: int, config: Mapping | None, render: bool, scale: int):
-        self.tracker, self.agent = tracker, trackers.make(tracker)
-        self.env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if render else None,
-                               obs_mode="frame+detections" if self.agent.needs_frame else "detections",
-                               render_scale=scale)
-        self.obs, info = self.env.reset(seed=seed)
-        self.agent.reset(info)
-        self.online: list[trackers.Tracks] = []
-        self.tracker_time = self.env_time = 0.0
-        self.done = False
 
-    def step(self, render: bool) -> np.ndarray | None:
-        """Answer the current frame and advance; with render, the annotated frame that was answered."""
-        start = time.perf_counter()
-        tracks = self.agent.update(self.obs)
-        mid = time.perf_counter()
-        action = tracks.to_action(self.env.action_space)
-        n = action["num_tracks"]
-        self.online.append(trackers.Tracks.of(action["ids"][:n], action["boxes"][:n]))
-        img = None
-        if render:
-            self.env.remember_tracks(tracks.ids, tracks.boxes, self.agent.debug(), self.tracker)
-            img = self.env.render()
-        self.obs, _, terminated, truncated, _ = self.env.step(action)
-        self.tracker_time, self.env_time = self.tracker_time + mid - start, self.env_time + time.perf_counter() - mid
-        self.done = terminated or truncated
-        return img
-
-    def record(self, scenario: str, seed: int, config: Mapping | None) -> dict:
-        env, frames = self.env, len(self.online)
-        scored = env.scored
-        return {"tracker": self.tracker, "params": self.agent.params, "scenario": str(scenario), "seed": seed,
-                "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
-                "per_target": env.metrics.per_target() if scored else {},
-                "tracker_fps": frames / max(self.tracker_time, 1e-9), "env_fps": frames / max(self.env_time, 1e-9)}
+def _record(run: Episode, spec: str, online: list, scenario: str, seed: int, config: Mapping | None) -> dict:
+    """The record of tracker `spec`'s finished episode, which reported the tracks `online`."""
+    env, frames = run.env, len(online)
+    scored = env.scored
+    return {"tracker": spec, "params": run.agent.params, "scenario": str(scenario), "seed": seed,
+            "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
+            "per_target": env.metrics.per_target() if scored else {},
+            "tracker_fps": frames / max(run.tracker_time, 1e-9), "env_fps": frames / max(run.env_time, 1e-9)}
 
 
 def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Mapping | None = None,
@@ -84,23 +63,30 @@ def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Map
     on a recorded sequence without ground truth."""
     if results and len(specs) != 1:
         raise ValueError("a results file takes one tracker")
-    runs = [_Episode(scenario, spec, seed, config, bool(video), scale) for spec in specs]
+    runs = [_episode(scenario, spec, seed, config, steps, bool(video), scale) for spec in specs]
+    online: list[list[trackers.Tracks]] = [[] for _ in runs]
     writer = VideoWriter(video, runs[0].env.metadata["render_fps"]) if video else None
-    limit = steps or runs[0].env.config.env.max_steps
-    steps_ = tqdm(range(limit), desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False) \
-        if progress else range(limit)
-    for _ in steps_:
-        panels = [run.step(bool(writer)) for run in runs]
-        if writer:  # panels side by side, a dark gap between them
-            gap = np.full((panels[0].shape[0], 4, 3), 30, np.uint8)
-            writer.write(np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1))
-        if runs[0].done:
-            break
+    with tqdm(total=runs[0].limit, desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False,
+              disable=not progress) as bar:
+        while not runs[0].done:  # the same world: every run ends on the same frame
+            panels = []
+            for run, spec, tracks in zip(runs, specs, online):
+                run.answer()
+                n = run.action["num_tracks"]
+                tracks.append(trackers.Tracks.of(run.action["ids"][:n], run.action["boxes"][:n]))
+                if writer:
+                    run.env.remember_tracks(run.tracks.ids, run.tracks.boxes, run.agent.debug(), spec)
+                    panels.append(run.env.render())
+                run.advance()
+            if writer:  # panels side by side, a dark gap between them
+                gap = np.full((panels[0].shape[0], 4, 3), 30, np.uint8)
+                writer.write(np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1))
+            bar.update()
     if writer:
         writer.close()
     if results:
-        write_results(results, [(t.ids, t.boxes) for t in runs[0].agent.results(runs[0].online)])
-    return [run.record(scenario, seed, config) for run in runs]
+        write_results(results, [(t.ids, t.boxes) for t in runs[0].agent.results(online[0])])
+    return [_record(run, spec, tracks, scenario, seed, config) for run, spec, tracks in zip(runs, specs, online)]
 
 
 def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Mapping | None = None,

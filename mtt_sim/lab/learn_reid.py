@@ -15,7 +15,9 @@ from tqdm import tqdm
 
 from mtt_sim.trackers import reid
 
-from mtt_sim.env import NO_TRACKS, TrackingEnv
+from mtt_sim.env import TrackingEnv
+from mtt_sim.lab.episode import Episode
+
 
 def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility: float = 0.9,
                    min_height: float = 24.0, progress: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -24,17 +26,13 @@ def training_crops(scenario: str, seeds, frames: int, every: int, min_visibility
     bar = tqdm(total=len(seeds) * frames, unit="frame", desc="rendering crops", disable=not progress)
     for seed in seeds:
         env = TrackingEnv(scenario, config={"env.max_steps": frames})
-        obs, _ = env.reset(seed=seed)
-        for k in range(frames):
-            if k % every == 0:
+        for now in Episode(env, seed):
+            if now.steps % every == 0:
                 t = env.truth
                 keep = (t.visibility >= min_visibility) & (t.boxes[:, 3] >= min_height)
-                features.extend(reid.lomo(reid.crops(obs["frame"], t.boxes[keep])))
+                features.extend(reid.lomo(reid.crops(now.obs["frame"], t.boxes[keep])))
                 classes.extend(seed * 1_000_000 + t.ids[keep].astype(int))
-            obs, _, term, trunc, _ = env.step(NO_TRACKS)
             bar.update()
-            if term or trunc:
-                break
     bar.close()
     return np.array(features), np.array(classes)
 

@@ -21,6 +21,7 @@ from scipy.optimize import linear_sum_assignment
 from mtt_sim import trackers
 
 from mtt_sim.lab import experiment
+from mtt_sim.lab.episode import Episode
 from mtt_sim.sim import scenario
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from mtt_sim.metrics import EpisodeMetrics, box_iou
@@ -38,11 +39,14 @@ def _env(n: int, obs_mode: str, size: tuple[int, int] = SIZE) -> TrackingEnv:
 
 
 def _steps_per_second(env: TrackingEnv, steps: int) -> float:
-    env.reset(seed=0)
+    """Steps per second of `env` reporting no tracks, over `steps` steps from seed 0 (its first reset untimed)."""
+    episode = Episode(env)
     start = time.perf_counter()
     for _ in range(steps):
-        if env.step(NO_TRACKS)[2]:  # a scenario whose world ends starts again
-            env.reset(seed=0)
+        episode.answer()
+        episode.advance()
+        if episode.done:  # a scenario whose world ends starts again
+            episode = Episode(env)
     return steps / (time.perf_counter() - start)
 
 
@@ -339,12 +343,8 @@ def _recorded(scenario: str, frames: int, config: dict | None = None,
               obs_mode: str = "frame+detections") -> tuple[dict, list[dict]]:
     """env.reset's info and `frames` observations of `scenario` (seed 0, no tracks), for timing trackers alone."""
     env = TrackingEnv(scenario, config={**(config or {}), "env.max_steps": frames}, obs_mode=obs_mode)
-    obs, info = env.reset(seed=0)
-    recorded = []
-    for _ in range(frames):
-        recorded.append({k: v.copy() if hasattr(v, "copy") else v for k, v in obs.items()})
-        obs = env.step(NO_TRACKS)[0]
-    return info, recorded
+    episode = Episode(env)
+    return episode.info, [{k: v.copy() if hasattr(v, "copy") else v for k, v in now.obs.items()} for now in episode]
 
 
 def _particle_filter_row(label: str, spec: str, scenario: str, targets: int, particles: int, reference, repeats: int,

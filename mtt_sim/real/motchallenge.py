@@ -20,10 +20,12 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from mtt_sim.env import NO_TRACKS, TrackingEnv
+from mtt_sim.env import TrackingEnv
+from mtt_sim.lab.episode import Episode
 from mtt_sim.metrics import EpisodeMetrics
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.real.sequence import Recording, by_frame, check_frames, read_rows
+
 
 def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
            config: Mapping | None = None, progress: bool = False) -> dict:
@@ -37,30 +39,24 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
     (out / "det").mkdir(exist_ok=True)
     for old in (out / "img1").glob("[0-9]*.jpg"):
         old.unlink()
-    obs, first = env.reset(seed=seed)
-    if "frame" in obs:
+    episode = Episode(env, seed, steps=steps)
+    if "frame" in episode.obs:
         (out / "img1").mkdir(exist_ok=True)
     sc = env.config
-    limit = steps or sc.env.max_steps
     gt_rows, det_rows = [], []
-    bar = tqdm(total=limit, unit="frame", desc=f"exporting {out}", disable=not progress)
-    frame = 0
-    while True:
-        frame += 1
-        if "frame" in obs:
-            cv2.imwrite(str(out / "img1" / f"{frame:06d}.jpg"), cv2.cvtColor(obs["frame"], cv2.COLOR_RGB2BGR),
-                        [cv2.IMWRITE_JPEG_QUALITY, 95])
-        t = env.truth
-        considered = t.visibility >= sc.scoring.min_visibility
-        gt_rows += [(frame, int(i), *b, int(c), 1, float(v))
-                    for i, b, c, v in zip(t.ids, t.boxes.tolist(), considered, t.visibility)]
-        dets = obs["detections"][: int(obs["num_detections"])]
-        det_rows += [(frame, -1, *d[:4], d[4], -1, -1, -1) for d in dets.tolist()]
-        bar.update()
-        obs, _, terminated, truncated, _ = env.step(NO_TRACKS)
-        if terminated or truncated or frame >= limit:
-            break
-    bar.close()
+    with tqdm(total=episode.limit, unit="frame", desc=f"exporting {out}", disable=not progress) as bar:
+        for now in episode:
+            frame = now.steps + 1  # numbered from 1; after the loop, the number of frames
+            if "frame" in now.obs:
+                cv2.imwrite(str(out / "img1" / f"{frame:06d}.jpg"), cv2.cvtColor(now.obs["frame"], cv2.COLOR_RGB2BGR),
+                            [cv2.IMWRITE_JPEG_QUALITY, 95])
+            t = env.truth
+            considered = t.visibility >= sc.scoring.min_visibility
+            gt_rows += [(frame, int(i), *b, int(c), 1, float(v))
+                        for i, b, c, v in zip(t.ids, t.boxes.tolist(), considered, t.visibility)]
+            dets = now.obs["detections"][: int(now.obs["num_detections"])]
+            det_rows += [(frame, -1, *d[:4], d[4], -1, -1, -1) for d in dets.tolist()]
+            bar.update()
     if recorded and env.scored:  # the recording's own ground truth, its lines as written, cut to the frames
         gt = env.source.folder / "gt" / "gt.txt"
         frames = read_rows(gt, 7)[:, 0]
@@ -74,7 +70,7 @@ def export(scenario: str, out: str | Path, seed: int = 0, steps: int | None = No
     info.optionxform = str
     name = f"{env.source.info.name}-twin" if recorded else sc.name
     width, height = env.source.image_size
-    info["Sequence"] = {"name": f"{name}-seed{seed}", "imDir": "img1", "frameRate": f"{first['frame_rate']:g}",
+    info["Sequence"] = {"name": f"{name}-seed{seed}", "imDir": "img1", "frameRate": f"{episode.info['frame_rate']:g}",
                         "seqLength": str(frame), "imWidth": str(width), "imHeight": str(height),
                         "imExt": ".jpg"}
     with (out / "seqinfo.ini").open("w") as f:

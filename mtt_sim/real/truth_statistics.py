@@ -15,17 +15,15 @@ MIN_MOVE = 0.1     # a heading counts where the feet moved at least this share o
 
 def record(scenario: str, config: dict | None = None, seed: int = 0, steps: int | None = None):
     """One episode without a tracker: each frame's truth and detections (x, y, w, h, confidence)."""
-    from mtt_sim.env import NO_TRACKS, TrackingEnv  # here: the env module is heavy, and only this needs it
+    # imported here: the env module is heavy (the runner imports it too), and only this function needs them
+    from mtt_sim.env import TrackingEnv
+    from mtt_sim.lab.episode import Episode
 
     env = TrackingEnv(scenario, config=config, obs_mode="detections")
-    obs, _ = env.reset(seed=seed)
     truths, detections = [], []
-    for _ in range(steps or env.config.env.max_steps):
+    for frame in Episode(env, seed, steps=steps):
         truths.append(env.truth)
-        detections.append(obs["detections"][: int(obs["num_detections"])].astype(float))
-        obs, _, terminated, truncated, _ = env.step(NO_TRACKS)
-        if terminated or truncated:
-            break
+        detections.append(frame.obs["detections"][: int(frame.obs["num_detections"])].astype(float))
     return truths, detections
 
 
