@@ -21,6 +21,7 @@ from mtt_sim import trackers
 from mtt_sim import env_ids
 
 from mtt_sim.sim import scenario
+from mtt_sim.lab.episode import Episode
 from mtt_sim.lab.experiment import run_episodes
 
 ROOT = Path(__file__).resolve().parents[2]  # the source checkout
@@ -62,12 +63,8 @@ def still(key: str, spec: str, path: Path, frame: int = 30, seed: int = 0, scale
     tracker = trackers.make(spec)
     env = gym.make(env_ids()[key], render_mode="rgb_array", render_scale=scale,
                    obs_mode="frame+detections" if tracker.needs_frame else "detections")
-    obs, info = env.reset(seed=seed)
-    tracker.reset(info)
-    for _ in range(frame + 1):
-        tracks = tracker.update(obs)
-        env.unwrapped.remember_tracks(tracks.ids, tracks.boxes, tracker.debug(), spec)
-        obs, *_ = env.step(tracks.to_action(env.action_space))
+    for now in Episode(env, seed, tracker, steps=frame + 1):
+        env.unwrapped.remember_tracks(now.tracks.ids, now.tracks.boxes, tracker.debug(), spec)
     cv2.imwrite(str(path), cv2.cvtColor(env.render(), cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 85])
     env.close()
 
