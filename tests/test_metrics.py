@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackeval_reference as ref
-from mtt_sim.metrics import EpisodeMetrics, box_iou, evaluate, gospa
+from mtt_sim.boxes import box_iou
+from mtt_sim.metrics import EpisodeMetrics, evaluate, gospa
 
 E = (np.zeros(0, int), np.zeros((0, 4)))
 

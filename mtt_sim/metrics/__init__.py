@@ -51,37 +51,11 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-EPS = np.finfo(float).eps
+from mtt_sim.boxes import EPS, box_iou, centre_distance, centres, check_frame, match, rows_of
 HIDDEN, REVEALED, WINDOW = 0.05, 0.5, 20  # the occlusion windows' visibilities and frames (module docstring)
 _CLEAR, _HIDDEN, _WINDOW = 0, 1, 2  # a target's occlusion: none under way, hidden and not yet revealed, in its window
 HOTA_ALPHAS = np.arange(0.05, 0.99, 0.05)
 SIMILARITIES = ("iou", "centroid")
-
-
-def box_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """IoU matrix (len(a), len(b)) of boxes x, y, w, h (TrackEval's guards against empty boxes)."""
-    a, b = np.asarray(a, float).reshape(-1, 4), np.asarray(b, float).reshape(-1, 4)
-    ax0, ay0, aw, ah = (a[:, k, None] for k in range(4))
-    bx0, by0, bw, bh = b.T
-    iw = np.minimum(ax0 + aw, bx0 + bw) - np.maximum(ax0, bx0)
-    ih = np.minimum(ay0 + ah, by0 + bh) - np.maximum(ay0, by0)
-    inter = np.maximum(iw, 0) * np.maximum(ih, 0)
-    area_a, area_b = aw * ah, bw * bh
-    union = area_a + area_b - inter
-    if (area_a <= EPS).any() or (area_b <= EPS).any():  # only then can the union vanish
-        inter[(area_a <= EPS) | (area_b <= EPS) | (union <= EPS)] = 0
-        union = np.where(union <= EPS, 1.0, union)
-    return inter / union
-
-
-def centres(boxes: np.ndarray) -> np.ndarray:
-    boxes = np.asarray(boxes, float).reshape(-1, 4)
-    return boxes[:, :2] + boxes[:, 2:] / 2
-
-
-def centre_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Euclidean distance matrix between box centres."""
-    return np.linalg.norm(centres(a)[:, None] - centres(b)[None], axis=2)
 
 
 def gospa(a: np.ndarray, b: np.ndarray, c: float, p: float) -> float:
@@ -304,15 +278,6 @@ class _OcclusionWindows:
                     "Reacquired": _ratio(decided[k, 0], decided[k, 1])} for i, k in self.ids.index.items()}
 
 
-def rows_of(ids: np.ndarray, wanted: np.ndarray) -> np.ndarray:
-    """Row of each wanted id in `ids` (unique), or -1."""
-    if not len(ids):
-        return np.full(len(wanted), -1)
-    order = np.argsort(ids)
-    pos = np.minimum(np.searchsorted(ids, wanted, sorter=order), len(ids) - 1)
-    return np.where(ids[order[pos]] == wanted, order[pos], -1)
-
-
 def _ratio(a: float, b: float) -> float | None:
     """a / b, or None (no value: nothing was counted) when b is 0."""
     return float(a / b) if b else None
@@ -358,8 +323,8 @@ class EpisodeMetrics:
         """Score one frame: GT ids (n,) and boxes (n, 4), tracker ids (m,) and boxes (m, 4), x, y, w, h. `everyone`:
         (ids, boxes, visibility) of every target in view, hidden ones too, for the occlusion windows."""
         frame = len(self._episode)
-        gt_ids, gt_boxes = _check_frame("gt", gt_ids, gt_boxes, frame)
-        trk_ids, trk_boxes = _check_frame("tracks", trk_ids, trk_boxes, frame)
+        gt_ids, gt_boxes = check_frame("gt", gt_ids, gt_boxes, f"frame {frame}")
+        trk_ids, trk_boxes = check_frame("tracks", trk_ids, trk_boxes, f"frame {frame}")
         if everyone is not None:
             everyone = _check_everyone(everyone, gt_ids, frame)
         stats = self._score(gt_ids, gt_boxes, trk_ids, trk_boxes)
@@ -389,11 +354,7 @@ class EpisodeMetrics:
     def _clear(self, g: np.ndarray, t: np.ndarray, sim: np.ndarray) -> FrameStats:
         """CLEAR matching of one frame with GT and tracks, updating the carry-over state."""
         prev, last = self._prev.a, self._last.a
-        score = 1000.0 * (t[None, :] == prev[g][:, None]) + sim
-        score[sim < self.threshold - EPS] = 0
-        rows, cols = linear_sum_assignment(score, maximize=True)
-        keep = score[rows, cols] > EPS
-        rows, cols = rows[keep], cols[keep]
+        rows, cols = match(sim, self.threshold - EPS, 1000.0 * (t[None, :] == prev[g][:, None]))
         mg, mt = g[rows], t[cols]
         before = last[mg]
         idsw = int(np.count_nonzero((before >= 0) & (before != mt)))
@@ -586,29 +547,13 @@ def _hota(flat: _Flat) -> dict:
             "AssRe": ass_re.mean(), "AssPr": ass_pr.mean(), "HOTA(0)": hota[0], "LocA(0)": loc_a[0]}
 
 
-def _check_frame(what: str, ids, boxes, frame: int) -> tuple[np.ndarray, np.ndarray]:
-    """Validated (ids int64 (n,), boxes float64 (n, 4)) of one frame, or a ValueError naming the problem."""
-    ids, boxes = np.asarray(ids), np.asarray(boxes, dtype=float)
-    if ids.size == 0 and boxes.size == 0:
-        return np.zeros(0, np.int64), np.zeros((0, 4))
-    if ids.ndim != 1 or boxes.shape != (len(ids), 4):
-        raise ValueError(f"frame {frame}: {what} ids must have shape (n,) and boxes (n, 4), got {ids.shape} and {boxes.shape}")
-    if ids.dtype.kind not in "iu":
-        raise ValueError(f"frame {frame}: {what} ids must be integers, got dtype {ids.dtype}")
-    if not np.isfinite(boxes).all():
-        raise ValueError(f"frame {frame}: {what} boxes must be finite; row {int(np.flatnonzero(~np.isfinite(boxes).all(1))[0])} is not")
-    if len(set(ids.tolist())) != len(ids):
-        raise ValueError(f"frame {frame}: {what} ids must be unique within a frame")
-    return ids.astype(np.int64), boxes
-
-
 def _check_everyone(everyone, gt_ids, frame: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Validated (ids, boxes, visibility) of every target in view, or a ValueError naming the problem."""
     try:
         ids, boxes, visibility = everyone
     except (TypeError, ValueError):
         raise ValueError(f"frame {frame}: everyone must be (ids, boxes, visibility) of every target in view") from None
-    ids, boxes = _check_frame("everyone", ids, boxes, frame)
+    ids, boxes = check_frame("everyone", ids, boxes, f"frame {frame}")
     visibility = np.asarray(visibility, float)
     if visibility.shape != ids.shape or not np.isfinite(visibility).all():
         raise ValueError(f"frame {frame}: everyone's visibility must be {ids.shape} finite numbers, got shape "

@@ -29,12 +29,12 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
-from scipy.optimize import brentq, least_squares, linear_sum_assignment, minimize
+from scipy.optimize import brentq, least_squares, minimize
 from scipy.special import expit, logit, logsumexp
 
 from mtt_sim.sim import scenario as scn
 from mtt_sim.real import truth_statistics as scene
-from mtt_sim.metrics import box_iou
+from mtt_sim.boxes import box_iou, match, overlap, union_boxes
 from mtt_sim.real.sequence import Recording, SequenceConfig, twin_sensor
 from mtt_sim.sim.truth import Truth, overlapping_pairs
 
@@ -71,22 +71,6 @@ class Associated:
     frames: int
 
 
-def _match(similarity: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
-    """Hungarian matching maximising the summed similarity over pairs at or above the threshold."""
-    if not similarity.size:
-        return np.zeros(0, int), np.zeros(0, int)
-    s = np.where(similarity >= threshold, similarity, 0.0)
-    r, c = linear_sum_assignment(-s)
-    ok = s[r, c] > 0
-    return r[ok], c[ok]
-
-
-def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    lo = np.minimum(a[:, :2], b[:, :2])
-    hi = np.maximum(a[:, :2] + a[:, 2:], b[:, :2] + b[:, 2:])
-    return np.concatenate([lo, hi - lo], axis=1)
-
-
 def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Associated:
     """Associate each frame's detections (n, 5) with its people (see the module docstring)."""
     people, dets = [], []
@@ -94,9 +78,9 @@ def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Asso
     for k, (t, d) in enumerate(zip(truths, detections)):
         d = np.asarray(d, float)
         sim = box_iou(t.boxes, d[:, :4]) if len(t) and len(d) else np.zeros((len(t), len(d)))
-        r1, c1 = _match(sim, MATCH_IOU)
+        r1, c1 = match(sim, MATCH_IOU)
         free_t, free_d = np.setdiff1d(np.arange(len(t)), r1), np.setdiff1d(np.arange(len(d)), c1)
-        r2, c2 = _match(sim[np.ix_(free_t, free_d)], OUTLIER_IOU)
+        r2, c2 = match(sim[np.ix_(free_t, free_d)], OUTLIER_IOU)
         r2, c2 = free_t[r2], free_d[c2]
         det_of = np.full(len(t), -1)
         det_of[r1], det_of[r2] = c1, c2
@@ -104,11 +88,11 @@ def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Asso
         kind[c1], kind[c2] = 0, 1
         boxes, j = t.boxes.astype(float), np.maximum(det_of, 0)
         found = det_of >= 0
-        match = np.full((len(t), 5), np.nan)
+        det_row = np.full((len(t), 5), np.nan)
         if len(d):
-            match[found] = d[j[found], :5]
+            det_row[found] = d[j[found], :5]
         people.append(np.c_[np.full(len(t), k), t.ids, t.visibility, boxes[:, 3], np.isin(np.arange(len(t)), r1),
-                            found, np.where(found, sim[np.arange(len(t)), j] if len(d) else 0, np.nan), boxes, match])
+                            found, np.where(found, sim[np.arange(len(t)), j] if len(d) else 0, np.nan), boxes, det_row])
         near = sim.max(axis=0) >= NEAR_IOU if len(t) else np.zeros(len(d), bool)
         dets.append(np.c_[np.full(len(d), k), d[:, :5], kind, near])
         if len(t) > 1:
@@ -116,7 +100,8 @@ def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Asso
             pairs += len(i)
             false = d[kind == 2, :4]
             if len(i) and len(false):
-                cover = box_iou(_union(boxes[i], boxes[jj]), false) >= MATCH_IOU
+                pair = np.arange(len(i))
+                cover = box_iou(union_boxes(boxes[np.r_[i, jj]], np.r_[pair, pair], len(i)), false) >= MATCH_IOU
                 alone = (sim[i][:, kind == 2] < MATCH_IOU) & (sim[jj][:, kind == 2] < MATCH_IOU)
                 merged += int((cover & alone).any(axis=1).sum())
         if len(d) and (~found).any():
@@ -132,10 +117,8 @@ def associate(truths: Sequence[Truth], detections: Sequence[np.ndarray]) -> Asso
 
 def _inside(boxes: np.ndarray, dets: np.ndarray) -> np.ndarray:
     """(people, detections): whether at least 80 % of a detection's area lies in a person's box."""
-    lo = np.maximum(boxes[:, None, :2], dets[None, :, :2])
-    hi = np.minimum(boxes[:, None, :2] + boxes[:, None, 2:], dets[None, :, :2] + dets[None, :, 2:])
-    inter = np.prod(np.clip(hi - lo, 0, None), axis=2)
-    return inter >= 0.8 * np.prod(dets[:, 2:], axis=1)[None]
+    inter, _, area = overlap(boxes[:, None], dets[None])
+    return inter >= 0.8 * area
 
 
 # ------------------------------------------------------------------ sequences of person-frames and of false positives
@@ -166,7 +149,7 @@ def false_runs(a: Associated, kinds: tuple[int, ...]) -> tuple[np.ndarray, np.nd
     for k in range(a.frames + 1):
         b = boxes[bounds[k]: bounds[k + 1]] if k < a.frames else np.zeros((0, 4))
         nb = near[bounds[k]: bounds[k + 1]] if k < a.frames else np.zeros(0, bool)
-        r, c = _match(box_iou(alive_box, b) if len(alive_box) and len(b) else np.zeros((len(alive_box), len(b))),
+        r, c = match(box_iou(alive_box, b) if len(alive_box) and len(b) else np.zeros((len(alive_box), len(b))),
                       MATCH_IOU)
         ended = np.setdiff1d(np.arange(len(alive_box)), r)
         lengths += alive_len[ended].tolist()

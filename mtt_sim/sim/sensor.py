@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 from scipy.special import expit, logit
 
-from mtt_sim.metrics import rows_of
+from mtt_sim.boxes import pair_iou, rows_of, union_boxes
 from mtt_sim.sim.config import Scenario, SensorConfig
 from mtt_sim.sim.truth import Truth, clip_boxes, overlapping_pairs
 
@@ -70,16 +70,6 @@ def true_confidence(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfi
     return expit(logit(cfg.conf_true) + cfg.conf_visibility * (visibility - 1) + cfg.conf_height * log_height(height, cfg))
 
 
-def _union(boxes: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
-    """Union box of the boxes in each group."""
-    lo = np.full((2, n_groups), np.inf)
-    hi = np.full((2, n_groups), -np.inf)
-    for axis in (0, 1):  # one-dimensional ufunc.at has a fast path (about 40x the two-dimensional one)
-        np.minimum.at(lo[axis], groups, boxes[:, axis])
-        np.maximum.at(hi[axis], groups, boxes[:, axis] + boxes[:, 2 + axis])
-    return np.concatenate([lo, hi - lo]).T
-
-
 def touching(labels: np.ndarray, la: int, lb: int, box: np.ndarray) -> bool:
     """Whether a pixel of label `la` is 8-adjacent to one of `lb` inside `box` (x0, y0, x1, y1)."""
     x0, y0, x1, y1 = box
@@ -123,14 +113,6 @@ def displace(boxes: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     c = boxes[:, :2] + boxes[:, 2:] / 2 + offsets[:, :2] * s
     wh = np.maximum(boxes[:, 2:] + offsets[:, 2:] * s, 0.1 * boxes[:, 2:])
     return np.concatenate([c - wh / 2, wh], axis=1)
-
-
-def pair_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """IoU of boxes a[..., i] and b[..., i] pairwise (broadcasting over the leading axes)."""
-    lo = np.maximum(a[..., :2], b[..., :2])
-    hi = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])
-    inter = np.prod(np.clip(hi - lo, 0, None), axis=-1)
-    return inter / np.maximum(np.prod(a[..., 2:], axis=-1) + np.prod(b[..., 2:], axis=-1) - inter, 1e-12)
 
 
 def offsets_in_band(boxes: np.ndarray, base: np.ndarray, mean: np.ndarray, sigma: np.ndarray, band: tuple[float, float],
@@ -305,7 +287,7 @@ class SyntheticSensor(Sensor):
         np.maximum.at(p, obj, pd[cand])
         area = np.prod(truth.visible_boxes[cand, 2:], axis=1)
         order = np.lexsort((area, obj))
-        return _union(truth.visible_boxes[cand], obj, n_obj), p, cand[order[np.append(np.flatnonzero(np.diff(obj[order])),
+        return union_boxes(truth.visible_boxes[cand], obj, n_obj), p, cand[order[np.append(np.flatnonzero(np.diff(obj[order])),
                                                                                      len(order) - 1)]]
 
     def _reports(self, truth: Truth, box: np.ndarray, lead: np.ndarray, hit: np.ndarray, outlier: np.ndarray,
@@ -434,7 +416,7 @@ def component_stats(comp: np.ndarray, count: int, mask: np.ndarray, weights: np.
     x, y = xy[:, 0], xy[:, 1]
     which = comp[y, x] - 1
     area = np.bincount(which, minlength=count - 1).astype(float)
-    boxes = _union(np.concatenate([xy, np.ones_like(xy)], axis=1).astype(float), which, count - 1)
+    boxes = union_boxes(np.concatenate([xy, np.ones_like(xy)], axis=1).astype(float), which, count - 1)
     return area, boxes, np.bincount(which, weights=weights[y, x], minlength=count - 1)
 
 
