@@ -154,7 +154,8 @@ class Jpda(Tracker):
     Gaps the paper leaves open, filled here: merged targets coming apart take one measurement each from the best
     joint event; duplicates (a young target, or one that shares a blob for merge_frames frames) are dropped.
 
-    Track management that departs from the paper (issue 15), each a parameter whose other value is the paper's:
+    Track management that departs from the paper, each a parameter whose other value is the paper's (the paper's reports
+    every newborn target and every member of a blob: thousands of false positives on a crowded scene):
     min_hits=3 reports a target once it has had a measurement 3 frames in a row, and from then on (1: at once);
     coast=true reports a confirmed target through its misses at its prediction until it vanishes, as Stone Soup
     does (false: only in frames with a measurement); early_duplicates=true drops a newborn duplicate sharing a blob

@@ -1,5 +1,6 @@
-"""Issue 15's textbook benchmark: point targets from Stone Soup's simulator, tracked by Stone Soup's JPDA with EHM and
-by our jpda and gnn on the very same detections; GOSPA, ids used and tracker time per frame.
+"""A textbook benchmark that holds jpda against an independent implementation: point targets from Stone Soup's
+simulator, tracked by Stone Soup's JPDA with EHM and by our jpda and gnn on the very same detections; GOSPA, ids used
+and tracker time per frame.
 
 The world: 20 targets under Stone Soup's ConstantVelocity(0.05) (a velocity variance of 0.05 per step, so our
 accel_sigma = sqrt(0.05) = 0.224, a discrete white acceleration with the same velocity noise), measured with

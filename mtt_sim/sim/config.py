@@ -103,7 +103,7 @@ class WorldConfig:
     max_births: int = setting(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
     far_scale: float = setting(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
     carry_frames: int = setting(0, "topdown: a target completely covered by a moving target of a higher layer rides with it "
-                                "for this many frames and is then left where it is (seed 002's Fig. 14); 0 = never",
+                                "for this many frames and is then left where it is (Liu et al.'s Fig. 14: a book carried under another); 0 = never",
                              "frames", 0, 100000)
 
 
