@@ -164,16 +164,21 @@ def test_an_empty_action_in_any_form_reports_nothing():
     env = TrackingEnv("crossing")
     env.reset(seed=0)
     for action in ({"ids": [], "boxes": []}, {"ids": np.zeros(0, int), "boxes": np.zeros((0, 4))}, NO_TRACKS):
-        assert env.step(action)[4]["frame"]["fp"] == 0
+        frame = env.step(action)[4]["frame"]
+        assert frame["tp"] == frame["fp"] == frame["idsw"] == 0 and frame["fn"] == frame["num_gt"] > 0
 
 
 def test_padded_action_counts_only_num_tracks_rows():
-    env = TrackingEnv("crossing")
-    env.reset(seed=0)
     ids = np.zeros(256, np.int64)
-    boxes = np.full((256, 4), np.nan, np.float32)  # rows past num_tracks are ignored
+    boxes = np.full((256, 4), np.nan, np.float32)  # rows past num_tracks are ignored, even NaN ones
     ids[0], boxes[0] = 5, (10, 10, 5, 5)
-    env.step({"ids": ids, "boxes": boxes, "num_tracks": 1})
+    padded, plain = TrackingEnv("crossing"), TrackingEnv("crossing")
+    padded.reset(seed=0)
+    plain.reset(seed=0)
+    _, reward, _, _, info = padded.step({"ids": ids, "boxes": boxes, "num_tracks": 1})
+    _, plain_reward, _, _, plain_info = plain.step({"ids": [5], "boxes": [[10, 10, 5, 5]]})
+    assert info["frame"] == plain_info["frame"] and reward == plain_reward  # the same as the one track unpadded
+    assert info["frame"]["tp"] + info["frame"]["fp"] == 1
 
 
 def test_bad_config_and_reset_options():

@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from helpers import BOOKS_WITH_DECOY
@@ -121,11 +121,39 @@ VALUES = st.recursive(
 
 @settings(max_examples=300, deadline=None)
 @given(st.dictionaries(st.sampled_from(VALID_KEYS) | st.text(max_size=8) | st.integers(-2, 2), VALUES, max_size=4))
+@example({"sensor.pd": np.float32(0.5), "sensor": {"clutter_rate": 3}, "groups.0.size": [10, 20.0],
+          "world.walls": np.bool_(True)})  # loads: random overrides seldom do
+@example({"groups.0.size": {"1": 7.0}, "groups": {0: {"count": np.int64(2)}}, "env.max_steps": 5})
 def test_every_override_problem_is_a_config_error(overrides):
+    """Any override either loads, and then the scenario holds every value asked for, or is a ConfigError (never
+    another exception, never a value dropped or changed on the way)."""
     try:
-        load("crossing", overrides)
+        sc = load("crossing", overrides)
     except ConfigError:
-        pass
+        return
+    loaded = scenario.to_mapping(sc)
+    for key, value in overrides.items():
+        node = loaded
+        for part in str(key).split("."):
+            node = _item(node, part)
+        assert _holds(value, node), (key, value, node)
+
+
+def _item(node, key):
+    """A table's entry, or a list's item by its index."""
+    return node[int(key)] if isinstance(node, list) else node[str(key)]
+
+
+def _holds(asked, got) -> bool:
+    """Whether a loaded value (plain tables and lists) is what an override asked for: each key of a table (a list's
+    items by index), each item of a list, a number or string itself (an integer given for a float reads as equal)."""
+    if isinstance(asked, (np.generic, np.ndarray)):
+        asked = asked.tolist()
+    if isinstance(asked, dict):
+        return all(_holds(v, _item(got, k)) for k, v in asked.items())
+    if isinstance(asked, (list, tuple)):
+        return isinstance(got, list) and len(got) == len(asked) and all(map(_holds, asked, got))
+    return got == asked
 
 
 @settings(max_examples=100, deadline=None)

@@ -5,27 +5,21 @@ import pytest
 
 from mtt_sim import TrackingEnv
 
+from mtt_sim.lab.episode import Episode
 from mtt_sim.real import truth_statistics as scene
 from mtt_sim.sim.config import ConfigError
 from mtt_sim.sim.scenario import load
 from mtt_sim.sim.sensor import CLUTTER
 from mtt_sim.sim.truth import Truth
 
-NO_TRACKS = {"ids": [], "boxes": np.zeros((0, 4))}
-
-
 def run(key, steps, **kwargs):
-    """Per-frame records of an episode: (truth, detections, frame mean, camera offset)."""
+    """Per-frame records of an episode of seed 0 without tracks: (truth, detections, frame mean, camera offset)."""
     env = TrackingEnv(key, **kwargs)
-    obs, _ = env.reset(seed=0)
     out = []
-    for _ in range(steps):
-        frame = obs.get("frame")
+    for now in Episode(env, steps=steps):
+        frame = now.obs.get("frame")
         out.append((env.truth, env.detections, None if frame is None else float(frame.mean()),
                     env.source.renderer.camera.offset.copy()))
-        obs, _, term, trunc, _ = env.step(NO_TRACKS)
-        if term or trunc:
-            break
     return env, out
 
 
@@ -35,9 +29,13 @@ RESOLUTION = {"crossing": (384, 288), "soccer": (720, 576), "umbrellas": (768, 5
 
 @pytest.mark.parametrize("key", sorted(RESOLUTION))
 def test_resolution_and_fifty_steps(key):
-    env, rec = run(key, 50)
-    assert (env.config.render.width, env.config.render.height) == RESOLUTION[key]
-    assert len(rec) == 50
+    env = TrackingEnv(key)
+    episode = Episode(env, steps=50)
+    width, height = RESOLUTION[key]
+    assert episode.info["image_size"] == (width, height)
+    for now in episode:  # every frame of that size, every observation inside the space the env declares
+        assert now.obs["frame"].shape == (height, width, 3) and env.observation_space.contains(now.obs)
+    assert episode.steps == 50  # fifty frames: the scene did not end before
 
 
 def test_crossing_two_walkers_are_cut_by_the_pole_hidden_by_the_sign_and_fragment():
