@@ -95,7 +95,7 @@ def check_frame(what: str, ids, boxes, where: str, positive: bool = False) -> tu
         raise ValueError(f"{where}: {what} boxes must be finite; row {int(np.flatnonzero(~np.isfinite(boxes).all(1))[0])} is not")
     if positive and not (boxes[:, 2:] > 0).all():
         raise ValueError(f"{where}: {what} boxes must have a positive width and height; row "
-                         f"{int(np.flatnonzero(~(boxes[:, 2:] > 0).all(1))[0])} has not")
+                         f"{int(np.flatnonzero(~(boxes[:, 2:] > 0).all(1))[0])} does not")
     if len(set(ids.tolist())) != len(ids):
         raise ValueError(f"{where}: {what} ids must be unique within a frame")
     return ids.astype(np.int64), boxes

@@ -6,6 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+import trackeval_reference as ref
 from mtt_sim.boxes import (EPS, box_iou, centre_distance, centres, check_frame, match, overlap, pair_iou, rows_of,
                            union_boxes)
 
@@ -32,6 +33,12 @@ def test_pair_iou_is_row_wise_broadcasting_and_keeps_float32_areas():
     np.testing.assert_allclose(pair_iou(a, moved), [[1 / 3, 1 / 3]] * 2 + [[1.0, 1.0]])
     inter, area, _ = overlap(a.astype(np.float32), b)
     assert area.dtype == np.float32 and inter.tolist() == [50.0, 50.0]
+
+
+@given(st.lists(st.tuples(*[st.floats(0, 50)] * 2, *[st.floats(0.1, 20)] * 2), min_size=1, max_size=6),
+       st.lists(st.tuples(*[st.floats(0, 50)] * 2, *[st.floats(0.1, 20)] * 2), min_size=1, max_size=6))
+def test_iou_matches_trackevals_plain_loop(a, b):
+    np.testing.assert_allclose(box_iou(np.array(a), np.array(b)), ref.iou(a, b), atol=1e-12)
 
 
 boxes = arrays(float, st.tuples(st.integers(0, 6), st.just(4)),
@@ -88,7 +95,7 @@ def test_check_frame_passes_good_frames_and_names_the_problem():
     assert ids.shape == (0,) and b.shape == (0, 4)
     with pytest.raises(ValueError, match=r"^frame 3: tracks boxes must be finite; row 1 is not$"):
         check_frame("tracks", [1, 2], [SQUARE, [0, 0, np.nan, 1]], "frame 3")
-    with pytest.raises(ValueError, match=r"^frame 3: tracks boxes must have a positive width and height; row 0 has not$"):
+    with pytest.raises(ValueError, match=r"^frame 3: tracks boxes must have a positive width and height; row 0 does not$"):
         check_frame("tracks", [1], [[0, 0, 0, 1]], "frame 3", positive=True)
     assert check_frame("tracks", [1], [[0, 0, 0, 1]], "frame 3")[1].tolist() == [[0, 0, 0, 1]]
     with pytest.raises(ValueError, match=r"gt ids must have shape \(n,\) and boxes \(n, 4\), got \(2,\) and \(1, 4\)"):

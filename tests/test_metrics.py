@@ -9,7 +9,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackeval_reference as ref
-from mtt_sim.boxes import box_iou
 from mtt_sim.metrics import EpisodeMetrics, evaluate, gospa
 
 E = (np.zeros(0, int), np.zeros((0, 4)))
@@ -202,12 +201,6 @@ def test_bounds_and_incremental_equals_batch(seq):
         assert m.summary() == evaluate(gt[: k + 1], tracks[: k + 1])  # summary never disturbs the state
     s = m.summary()
     assert s["MOTA"] <= 1 and 0 <= s["HOTA"] <= 1 and 0 <= s["IDF1"] <= 1 and s["GOSPA"] >= 0
-
-
-@given(st.lists(st.tuples(*[st.floats(0, 50)] * 2, *[st.floats(0.1, 20)] * 2), min_size=1, max_size=6),
-       st.lists(st.tuples(*[st.floats(0, 50)] * 2, *[st.floats(0.1, 20)] * 2), min_size=1, max_size=6))
-def test_iou_matches_the_plain_loop(a, b):
-    np.testing.assert_allclose(box_iou(np.array(a), np.array(b)), ref.iou(a, b), atol=1e-12)
 
 
 def test_a_long_episode_matches_the_dense_restatement_and_every_frame_keeps_its_gospa():

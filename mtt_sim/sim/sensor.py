@@ -110,6 +110,7 @@ def displace(boxes: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     offsets[:, 2:], all in units of the box's scale sqrt(w h) (a real detector's pixel errors scale with it, alike
     across and down); a size keeps at least a tenth of what it was."""
     s = np.sqrt(np.prod(boxes[:, 2:], axis=1))[:, None]
+    # the centre in the boxes' own dtype (float32 truth boxes), where mtt_sim.boxes.centres casts to float64 first
     c = boxes[:, :2] + boxes[:, 2:] / 2 + offsets[:, :2] * s
     wh = np.maximum(boxes[:, 2:] + offsets[:, 2:] * s, 0.1 * boxes[:, 2:])
     return np.concatenate([c - wh / 2, wh], axis=1)
