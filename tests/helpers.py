@@ -7,7 +7,7 @@ import numpy as np
 from mtt_sim.sim import scenario
 from mtt_sim.env import TrackingEnv
 
-EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"  # scenes of the README's experiments
+EXPERIMENTS = Path(__file__).resolve().parents[1] / "docs" / "experiments"  # scenes of the docs pages' experiments
 # `books` before it was rebuilt for Liu et al.'s Fig. 14: a carried top book
 BOOKS_WITH_DECOY = str(EXPERIMENTS / "books_with_decoy.toml")
 IDEAL = {"preset": "ideal", "clutter_rate": 0.0, "merge_prob": 0.0, "fragment_prob": 0.0}

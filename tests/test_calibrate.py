@@ -10,10 +10,10 @@ import pytest
 import mtt_sim  # noqa: F401  (registers the env ids)
 from helpers import write_sequence
 from mtt_sim import cli
-from mtt_sim.real import calibrate
-from mtt_sim.real import motchallenge
+from mtt_sim.sim2real import calibrate
+from mtt_sim.lab.export import export_episode
 from mtt_sim.sim import scenario
-from mtt_sim.real import validate
+from mtt_sim.sim2real import validate
 from mtt_sim.env import NO_TRACKS
 from mtt_sim.sim.truth import Truth
 
@@ -39,7 +39,7 @@ def twin(tmp_path_factory):
     """A sequence whose detections are the synthetic detector's with the KNOWN keys (1,000 frames, 80 people)."""
     root = tmp_path_factory.mktemp("twin")
     gt = write_sequence(root / "People", gt=people(1000), size=(1280, 720))
-    motchallenge.export(gt, root / "twin", seed=3, config={"sensor": KNOWN})
+    export_episode(gt, root / "twin", seed=3, config={"sensor": KNOWN})
     return root / "twin"
 
 
@@ -159,7 +159,7 @@ def two_sequences(tmp_path_factory):
     folders = []
     for k, count in enumerate((4, 5)):
         gt = write_sequence(root / f"Gt{k}", gt=people(80, count=count), size=(1280, 720))
-        motchallenge.export(gt, root / f"Seq{k}", seed=k, config={"sensor": KNOWN})
+        export_episode(gt, root / f"Seq{k}", seed=k, config={"sensor": KNOWN})
         folders.append(root / f"Seq{k}")
     return folders
 

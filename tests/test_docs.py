@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import mtt_sim
-from mtt_sim.show import docsite
+from mtt_sim.lab import docsite
 from mtt_sim.sim import scenario
 
 ROOT = Path(__file__).resolve().parent.parent

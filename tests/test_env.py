@@ -15,7 +15,6 @@ from mtt_sim import ActionError, ConfigError, TrackingEnv
 from mtt_sim.env import NO_TRACKS
 
 ENV_IDS = sorted(mtt_sim.env_ids().values())
-NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4), np.float32)}
 
 
 def echo(obs):

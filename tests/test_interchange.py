@@ -10,6 +10,7 @@ import pytest
 import mtt_sim
 from mtt_sim import trackers
 from mtt_sim import cli
+from mtt_sim.lab.export import export_episode
 from mtt_sim.real import motchallenge
 from mtt_sim.real import sequence as seq
 from mtt_sim.env import TrackingEnv
@@ -20,7 +21,7 @@ STEPS = 40
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory):
     folder = tmp_path_factory.mktemp("seq")
-    summary = motchallenge.export("mot17_like", folder, seed=0, steps=STEPS)
+    summary = export_episode("mot17_like", folder, seed=0, steps=STEPS)
     return folder, summary
 
 

@@ -6,7 +6,7 @@ import pytest
 from mtt_sim import TrackingEnv
 
 from mtt_sim.lab.episode import Episode
-from mtt_sim.real import truth_statistics as scene
+from mtt_sim.sim2real import truth_statistics
 from mtt_sim.sim.config import ConfigError
 from mtt_sim.sim.scenario import load
 from mtt_sim.sim.sensor import CLUTTER
@@ -122,16 +122,16 @@ def walker(ids, path):
 
 def test_heading_changes_by_hand():
     straight = [(10.0 * k, 0.0) for k in range(11)]
-    assert scene.heading_changes(walker(1, straight)).tolist() == [0.0]
+    assert truth_statistics.heading_changes(walker(1, straight)).tolist() == [0.0]
     corner = [(10.0 * k, 0.0) for k in range(6)] + [(50.0, 10.0 * k) for k in range(1, 6)]  # right, then down
-    assert scene.heading_changes(walker(1, corner)) == pytest.approx([90.0])
+    assert truth_statistics.heading_changes(walker(1, corner)) == pytest.approx([90.0])
     still = [(0.0, 0.0)] * 11  # no direction to speak of
-    assert len(scene.heading_changes(walker(1, still))) == 0
+    assert len(truth_statistics.heading_changes(walker(1, still))) == 0
 
 
 def test_mot17_like_has_mot17_scene_statistics():
-    truths, _ = scene.record("mot17_like", seed=0)
-    stats = scene.summary(truths)
+    truths, _ = truth_statistics.record("mot17_like", seed=0)
+    stats = truth_statistics.summary(truths)
     assert len(truths) >= 600
     assert 16 <= stats["people per frame"] <= 28  # MOT17: 21 on average
     assert 12 <= stats["heading change p90 (deg)"] <= 20  # real TUD and MOT17 trajectories

@@ -1,12 +1,11 @@
 """The detector models: known answers for merges, fragments, clutter statistics and the ideal case."""
 
 import numpy as np
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from helpers import placed, still, tiny
-from mtt_sim.real import calibrate
+from mtt_sim.sim2real import calibrate
 from mtt_sim.sim import sensor as sensor_mod
 from mtt_sim.sim.config import SensorConfig
 from mtt_sim.sim.sensor import CLUTTER, components, detection_probabilities

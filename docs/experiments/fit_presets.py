@@ -14,7 +14,7 @@ from pathlib import Path
 
 from scipy.special import expit, logit
 
-from mtt_sim.real import calibrate
+from mtt_sim.sim2real import calibrate
 
 from mtt_sim.sim import scenario
 

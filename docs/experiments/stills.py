@@ -9,7 +9,7 @@ Gym agent can use, `RecordVideo` included). Run from the repository root:
 
 from __future__ import annotations
 
-from mtt_sim.show.docsite import still
+from mtt_sim.lab.docsite import still
 from mtt_sim.lab.experiment import run_episodes
 
 STILLS = [  # (scenario, tracker, file, frame, seed, render scale)

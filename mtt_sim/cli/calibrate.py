@@ -21,7 +21,7 @@ def add(subparsers) -> None:
 
 def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".toml",))
-    from mtt_sim.real import calibrate
+    from mtt_sim.sim2real import calibrate
 
     fitted = calibrate.calibrate(args.folders, seeds=args.seeds)
     print(calibrate.report(fitted))

@@ -18,6 +18,6 @@ def add(subparsers) -> None:
 def run(args) -> int:
     if not (Path(args.data) / "mot15").is_dir():
         raise UsageError("data", f"{args.data!r}: expected the shared data folder (with mot15/, reference/, mot17/)")
-    from mtt_sim.real import check
+    from mtt_sim.sim2real import check
 
     return 0 if check.check(args.data) else 1

@@ -8,7 +8,7 @@ from mtt_sim.cli.arguments import FORCE_HELP, output_folder, require
 
 
 def add(subparsers) -> None:
-    p = subparsers.add_parser("docs", help="build the documentation site (MkDocs): the README, a page per scenario "
+    p = subparsers.add_parser("docs", help="build the documentation site (MkDocs): the pages under docs/, a page per scenario "
                                            "and per tracker, the configuration reference (the [docs] extra)")
     p.add_argument("--out", required=True, help="the site's folder")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
@@ -21,7 +21,7 @@ def run(args) -> int:
     require("material", "docs", "docs")
     import tempfile
 
-    from mtt_sim.show import docsite
+    from mtt_sim.lab import docsite
 
     with tempfile.TemporaryDirectory() as work:
         docsite.build(out, Path(work))

@@ -21,7 +21,7 @@ def run(args) -> int:
     overrides = episode_overrides(args)
     loaded([args.scenario], overrides)
     out = output_folder(args.out, args.force, "--out", "replace its sequence")
-    from mtt_sim.real import motchallenge
+    from mtt_sim.lab.export import export_episode
 
-    print_fields(motchallenge.export(args.scenario, out, args.seed, args.steps, overrides, progress=True))
+    print_fields(export_episode(args.scenario, out, args.seed, args.steps, overrides, progress=True))
     return 0

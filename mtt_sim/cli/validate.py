@@ -21,7 +21,7 @@ def add(subparsers) -> None:
 
 def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".md",))
-    from mtt_sim.real import validate
+    from mtt_sim.sim2real import validate
 
     result = validate.validate(args.folders, args.trackers or validate.TRACKERS, seeds=args.seeds, workers=args.workers,
                                progress=True)

@@ -28,7 +28,7 @@ from mtt_sim.lab.episode import Episode
 from mtt_sim.env import TrackingEnv
 from mtt_sim.metrics import METRICS, PER_TARGET
 from mtt_sim.real.motchallenge import write_results
-from mtt_sim.show.overlay import VideoWriter
+from mtt_sim.show.video import VideoWriter
 
 BACKENDS = ("local", "ray")
 

@@ -24,7 +24,8 @@ from mtt_sim.lab import experiment
 from mtt_sim.lab.episode import Episode
 from mtt_sim.sim import scenario
 from mtt_sim.env import NO_TRACKS, TrackingEnv
-from mtt_sim.metrics import EpisodeMetrics, box_iou
+from mtt_sim.boxes import box_iou
+from mtt_sim.metrics import EpisodeMetrics
 
 SIZE = (640, 480)
 

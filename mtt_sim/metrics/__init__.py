@@ -35,9 +35,7 @@ Semantics, following TrackEval where other tools differ:
   `everyone`): see `mtt_sim.metrics.occlusion`.
 """
 
-from mtt_sim.boxes import EPS, box_iou  # re-exported for lab/perf.py and real/sequence.py, which import them from here
 from mtt_sim.metrics.episode import METRICS, PER_TARGET, EpisodeMetrics, FrameStats, evaluate
 from mtt_sim.metrics.gospa import gospa, gospa_of_points
 
-__all__ = ["EpisodeMetrics", "FrameStats", "evaluate", "METRICS", "PER_TARGET", "gospa", "gospa_of_points", "EPS",
-           "box_iou"]
+__all__ = ["EpisodeMetrics", "FrameStats", "evaluate", "METRICS", "PER_TARGET", "gospa", "gospa_of_points"]

@@ -1,1 +1,2 @@
-"""Real data: MOTChallenge sequences and files, the detector's calibration, the sim-to-real validation."""
+"""Real data: a MOTChallenge sequence folder as a source (its frames, detections and ground truth), and the
+benchmark's files."""

@@ -24,9 +24,8 @@ from typing import Mapping
 
 import cv2
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
-from mtt_sim.metrics import EPS, box_iou
+from mtt_sim.boxes import EPS, box_iou, match
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.config import EnvConfig, GroupConfig, ScoringConfig, SensorConfig, table
@@ -123,12 +122,8 @@ class Recording:
         g = self._gt_rows(k)
         keep_tracks = np.ones(len(track_boxes), bool)
         if self.benchmark != "MOT15" and len(g) and len(track_boxes):
-            similarity = box_iou(g[:, 2:6], track_boxes)
-            similarity[similarity < 0.5 - EPS] = 0
-            rows, cols = linear_sum_assignment(-similarity)
-            matched = similarity[rows, cols] > EPS
-            distractor = np.isin(g[rows[matched], 7], DISTRACTORS[self.benchmark])
-            keep_tracks[cols[matched][distractor]] = False
+            rows, cols = match(box_iou(g[:, 2:6], track_boxes), 0.5 - EPS)
+            keep_tracks[cols[np.isin(g[rows, 7], DISTRACTORS[self.benchmark])]] = False
         scored = (g[:, 6] != 0) & (g[:, 7] == PEDESTRIAN)  # MOT15's rows are all pedestrians (class 1)
         return g[scored, 1].astype(np.int64), g[scored, 2:6], keep_tracks
 

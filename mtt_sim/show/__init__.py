@@ -1,1 +1,1 @@
-"""Pictures: overlays on frames, videos, the live viewer and the documentation site."""
+"""Pictures: the overlays render() draws on a frame, video files and the live viewer."""

@@ -18,7 +18,7 @@ from typing import Sequence
 import numpy as np
 from scipy.stats import kendalltau
 
-from mtt_sim.real import calibrate
+from mtt_sim.sim2real import calibrate
 
 from mtt_sim.lab import experiment
 

@@ -33,7 +33,7 @@ from scipy.optimize import brentq, least_squares, minimize
 from scipy.special import expit, logit, logsumexp
 
 from mtt_sim.sim import scenario as scn
-from mtt_sim.real import truth_statistics as scene
+from mtt_sim.sim2real import truth_statistics
 from mtt_sim.boxes import box_iou, match, overlap, union_boxes
 from mtt_sim.real.sequence import Recording, SequenceConfig, twin_sensor
 from mtt_sim.sim.truth import Truth, overlapping_pairs
@@ -392,7 +392,7 @@ def scenario_statistics(scenario: str, config: dict | None = None, seeds: Sequen
     what a preset does on a scene, e.g. its average precision."""
     truths, detections = [], []
     for seed in seeds:
-        t, d = scene.record(scenario, config, seed, steps)
+        t, d = truth_statistics.record(scenario, config, seed, steps)
         truths += t
         detections += d
     return statistics(associate(truths, detections))
