@@ -33,7 +33,7 @@ def per_frame(rows: np.ndarray, frames: int) -> list[tuple[np.ndarray, np.ndarra
 
 def evaluate_results(sequence_folder: str | Path, results: str | Path, benchmark: str | None = None, **scoring) -> dict:
     """Our metrics of a results file against a sequence's ground truth, scored as TrackEval scores the sequence's
-    benchmark (see `mtt_sim.sequence`): the same numbers the env gives for the same tracks."""
+    benchmark (see `mtt_sim.real.sequence`): the same numbers the env gives for the same tracks."""
     recording = Recording(sequence_folder, benchmark)
     if not recording.scored:
         raise FileNotFoundError(f"{Path(sequence_folder) / 'gt' / 'gt.txt'}: not found; there is no ground truth to score")

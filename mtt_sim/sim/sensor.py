@@ -1,7 +1,7 @@
 """Simulated detectors: turn one frame's truth (or its pixels) into boxes with confidences.
 
 ``synthetic`` reads the truth (and the label map, where there is one) and fails the way real detectors fail
-(``mtt_sim.calibrate`` fits it to real detections):
+(``mtt_sim.sim2real.calibrate`` fits it to real detections):
 - misses: P(detect) is logistic in the visible fraction, the log of the box height and the target's own ease of
   detection (drawn once), raised for a target detected in the previous frame and lowered after a miss (a two-state
   Markov chain per target), so misses come in runs;

@@ -3,7 +3,7 @@
 Each frame's detections are associated with its people (the sequence's ground truth, every person row, scored or
 not: a real detector fires on them all) by the Hungarian method, first at IoU >= 0.5 (true detections), then the
 rest at IoU >= 0.3 (outliers: the person was detected, with a poor box); what is left is a false positive.
-The fit, per part of the model (`mtt_sim.sensor`):
+The fit, per part of the model (`mtt_sim.sim.sensor`):
 - misses: maximum likelihood (L-BFGS) of the two-state chain of detections with logistic covariates and a
   per-person random ease of detection over every person-frame (a person seen in the previous frame continues its
   chain, a new one starts at its long-run P), then the intercept matched to the data's share of detected frames;
@@ -455,7 +455,7 @@ def to_toml(c: Calibration) -> str:
     return sensor_toml(c.sensor, [
         f"mtt-sim calibrate: the synthetic detector fitted to {', '.join(Path(s).name for s in c.sources)}",
         f"({c.person_frames} person-frames, {c.detections} detections). Misses: maximum likelihood; boxes, false",
-        "positives and confidences: matched moments (see mtt_sim/calibrate.py)."])
+        "positives and confidences: matched moments (see mtt_sim/sim2real/calibrate.py)."])
 
 
 def sensor_toml(sensor: dict, comments: Sequence[str] = ()) -> str:
