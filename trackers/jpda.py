@@ -18,6 +18,7 @@ from scipy.sparse.csgraph import connected_components
 from .assignment import chi2_gate, murty
 from .base import Param, Tracker, Tracks, covariance_ellipse, detections, register
 from .kalman import KalmanBank, point_model
+from .trackbook import CONFIRMED, TrackBook
 
 
 ENUMERATE_UP_TO = 256  # clusters with at most this many joint events (an upper bound) are enumerated
@@ -207,14 +208,11 @@ class Jpda(Tracker):
     def reset(self, info=None):
         p = self.params
         self.model = point_model(p["accel_sigma"], p["meas_sigma"], p["speed_sigma0"])
-        self.kf = KalmanBank(self.model)
-        self.ids, self.misses, self.hits = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64)
-        self.confirmed = np.zeros(0, bool)
-        self.age, self.together = np.zeros(0, np.int64), np.zeros(0, np.int64)
-        self.sizes = np.zeros((0, 2))
-        self.ended = {"ids": np.zeros(0, np.int64), "age": np.zeros(0, np.int64), "sizes": np.zeros((0, 2)),
-                      "confirmed": np.zeros(0, bool), "bank": KalmanBank(self.model)}
-        self.next_id = 1
+        # The targets: streak counts frames in a row with a measurement, together frames in one blob, boxes[:, 2:]
+        # is the size (hits and score unused). Ended targets wait in their own book to be revived; there age counts
+        # the frames since they ended.
+        self.book = TrackBook(KalmanBank(self.model), together=np.int64)
+        self.ended = TrackBook(KalmanBank(self.model))
         self.gate = chi2_gate(2, p["gate_probability"])
         self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool),
                      "ids": np.zeros(0, np.int64), "centres": np.zeros((0, 2)), "S": np.zeros((0, 2, 2))}
@@ -222,13 +220,12 @@ class Jpda(Tracker):
     # -------------------------------------------------------------- one frame
 
     def update(self, obs) -> Tracks:
-        p = self.params
+        p, book = self.params, self.book
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["min_confidence"]]
         z = dets[:, :2] + dets[:, 2:4] / 2
-        self.kf.predict()
-        self.ended["bank"].predict()
-        self.ended["age"] += 1
+        book.kf.predict()
+        self.ended.predict()
         beta, gated, g = self._associate(z)
         situ, unexplained = situations(beta[:, 1:].T)
         if p["situations"] and p["early_duplicates"] and len(z) and \
@@ -239,8 +236,9 @@ class Jpda(Tracker):
             self._apart_is_not_merged(situ, _most_probable(beta))
         if p["situations"]:
             self._separate(situ, beta, g)
-        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": self.ids.copy(),
-                     "centres": self.kf.measurement(), "S": self.kf.innovation_covariance()}
+        kf = book.kf
+        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": book.ids.copy(),
+                     "centres": kf.measurement(), "S": kf.innovation_covariance()}
         self._jpda_update(beta, z)
         best = _most_probable(beta)
         kind = np.array(situ, dtype=object)
@@ -249,44 +247,44 @@ class Jpda(Tracker):
         # state and _separate's best joint event decides who leaves the blob as whom; occlusion_velocity=keep lets
         # each keep its own velocity instead (over 10 seeds of crossing and soccer the two do not differ
         # significantly).
-        self.kf.x[occluded, :2] = z[best[occluded]]
+        kf.x[occluded, :2] = z[best[occluded]]
         if p["occlusion_velocity"] == "zero":
-            self.kf.x[occluded, 2:] = 0.0
+            kf.x[occluded, 2:] = 0.0
             if p["occlusion_covariance"] == "full":  # a velocity set to 0 is not known: its covariance restarts too
-                self.kf.P[occluded, 2:, 2:] = self.model.P0[2:, 2:]
-        self.kf.P[occluded, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
-        self.kf.P[occluded, :2, 2:] = self.kf.P[occluded, 2:, :2] = 0.0
+                kf.P[occluded, 2:, 2:] = self.model.P0[2:, 2:]
+        kf.P[occluded, :2, :2] = self.model.P0[:2, :2]  # a fresh position, uncorrelated with the velocity
+        kf.P[occluded, :2, 2:] = kf.P[occluded, 2:, :2] = 0.0
         hidden = self._surplus(occluded, best[occluded], dets) if p["blob_report"] == "size" else occluded[:0]
         sized = np.flatnonzero((kind == NORMAL) | (kind == SEPARATED))
-        self.sizes[sized] = dets[best[sized], 2:4]
-        self.misses = np.where(kind == VANISHED, self.misses + 1, 0)
+        book.boxes[sized] = dets[best[sized], :4]
+        book.misses = np.where(kind == VANISHED, book.misses + 1, 0)
+        book.streak = np.where(book.misses == 0, book.streak + 1, 0)
         own = (kind == NORMAL) | (kind == SEPARATED) | (kind == SPLIT)  # a miss says nothing either way
-        self.together = np.where(own, 0, self.together + (kind == OCCLUDED))
-        self.age += 1
-        hidden_ids = self.ids[hidden]
+        book.together = np.where(own, 0, book.together + (kind == OCCLUDED))
+        book.age += 1
+        hidden_ids = book.ids[hidden]
         if p["situations"]:
             self._drop_duplicates(situ, best)
-        self._end_vanished()
+        book.move(book.misses >= p["vanish_frames"], self.ended, age=0)  # vanished: ended, for the revival pool
         fresh = self._revive(z, dets, unexplained) if p["situations"] else unexplained
-        self._add(z[fresh], dets[fresh, 2:4])
-        self.last["situations"] += [REVIVED] * (len(self.ids) - len(situ) - len(fresh)) + [NEW] * len(fresh)
-        self.hits = np.where(self.misses == 0, self.hits + 1, 0)
-        self.confirmed |= self.hits >= p["min_hits"]  # once: a confirmed target stays confirmed through its misses
-        seen = self.confirmed & ((self.misses == 0) | p["coast"])
-        seen[np.isin(self.ids, hidden_ids)] = False
-        centre = self.kf.x[seen, :2]
-        return Tracks.of(self.ids[seen], np.c_[centre - self.sizes[seen] / 2, self.sizes[seen]])
+        book.add(dets[fresh, :4], np.zeros(len(fresh)), z[fresh])  # new targets at rest (section 5, 2)
+        self.last["situations"] += [REVIVED] * (len(book) - len(situ) - len(fresh)) + [NEW] * len(fresh)
+        book.state[book.streak >= p["min_hits"]] = CONFIRMED  # once: a confirmed target stays so through its misses
+        seen = (book.state == CONFIRMED) & ((book.misses == 0) | p["coast"])
+        seen[np.isin(book.ids, hidden_ids)] = False
+        size = book.boxes[seen, 2:]
+        return Tracks.of(book.ids[seen], np.c_[kf.x[seen, :2] - size / 2, size])
 
     def _associate(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """beta (targets, 1 + measurements) cluster by cluster, and the validation (gate) matrix."""
-        p, n, m = self.params, len(self.ids), len(z)
+        p, n, m = self.params, len(self.book), len(z)
         beta = np.zeros((n, m + 1))
         beta[:, 0] = 1.0
         if not n or not m:
             return beta, np.zeros((n, m), bool), np.zeros((n, m))
-        d2 = self.kf.mahalanobis(z)
+        d2 = self.book.kf.mahalanobis(z)
         gated = d2 <= self.gate
-        det_s = np.linalg.det(self.kf.innovation_covariance())
+        det_s = np.linalg.det(self.book.kf.innovation_covariance())
         g = np.where(gated, np.exp(-0.5 * d2) / (2 * np.pi * np.sqrt(det_s))[:, None], 0.0)
         t_label, z_label = clusters(gated)
         has = gated.any(axis=1)
@@ -307,7 +305,7 @@ class Jpda(Tracker):
         occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
         if len(occluded) < 2:
             return
-        centre, half = self.kf.x[occluded, :2], self.sizes[occluded] / 2
+        centre, half = self.book.kf.x[occluded, :2], self.book.boxes[occluded, 2:] / 2
         apart = (np.abs(centre[:, None] - centre[None]) >= half[:, None] + half[None]).any(axis=2)
         touching = (~apart & (best[occluded][:, None] == best[occluded][None])).sum(axis=1) > 1  # itself too
         for t in occluded[~touching]:
@@ -317,7 +315,7 @@ class Jpda(Tracker):
         """Targets that shared a blob last frame and now see several measurements take one each, from the most
         probable joint event, instead of the soft JPDA mixture that would hold them together at the blob (the
         paper's split rule is meant for fragments of one target; it does not say how merged targets come apart)."""
-        rows = np.flatnonzero((self.together > 0) & (np.array(situ, dtype=object) == SPLIT))
+        rows = np.flatnonzero((self.book.together > 0) & (np.array(situ, dtype=object) == SPLIT))
         if len(rows) < 2:
             return
         cols = np.flatnonzero(beta[rows, 1:].sum(axis=0) > 0)
@@ -334,23 +332,24 @@ class Jpda(Tracker):
 
     def _jpda_update(self, beta: np.ndarray, z: np.ndarray) -> None:
         """Eq. 10-12 for every target at once: the beta-weighted innovation, and the covariance with its spread."""
-        if not len(self.ids) or not len(z):
+        kf = self.book.kf
+        if not len(kf) or not len(z):
             return
-        H, R, x, P = self.model.H, self.model.R, self.kf.x, self.kf.P
+        H, R, x, P = self.model.H, self.model.R, kf.x, kf.P
         S = H @ P @ H.T + R
         K = np.linalg.solve(S, H @ P).transpose(0, 2, 1)
         nu = z[None, :, :] - (x @ H.T)[:, None, :]
         b, b0 = beta[:, 1:], beta[:, 0]
         combined = np.einsum("nm,nmi->ni", b, nu)
         spread = np.einsum("nm,nmi,nmj->nij", b, nu, nu) - combined[:, :, None] * combined[:, None, :]
-        self.kf.x = x + np.einsum("nij,nj->ni", K, combined)
+        kf.x = x + np.einsum("nij,nj->ni", K, combined)
         P = P - (1 - b0)[:, None, None] * (K @ S @ K.transpose(0, 2, 1)) + K @ spread @ K.transpose(0, 2, 1)
-        self.kf.P = (P + P.transpose(0, 2, 1)) / 2  # keep it symmetric against rounding
+        kf.P = (P + P.transpose(0, 2, 1)) / 2  # keep it symmetric against rounding
 
     def _by_blob(self, occluded: np.ndarray, blob: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Occluded targets (rows) and their blobs (measurements) ordered by blob, then eldest, then lowest id, the
         index of each blob's first, and each target's rank in its blob (0 the eldest)."""
-        order = np.lexsort((self.ids[occluded], -self.age[occluded], blob))
+        order = np.lexsort((self.book.ids[occluded], -self.book.age[occluded], blob))
         blob = blob[order]
         starts = np.flatnonzero(np.r_[True, blob[1:] != blob[:-1]])
         rank = np.arange(len(blob)) - np.repeat(starts, np.diff(np.r_[starts, len(blob)]))
@@ -365,14 +364,14 @@ class Jpda(Tracker):
         if len(occluded) < 2:
             return False
         occluded, _, _, rank = self._by_blob(occluded, best[occluded])
-        p = self.params
-        duplicate = self.age[occluded] < p["vanish_frames"]
+        p, book = self.params, self.book
+        duplicate = book.age[occluded] < p["vanish_frames"]
         if not newborn_only:
-            duplicate |= self.together[occluded] >= p["merge_frames"]
+            duplicate |= book.together[occluded] >= p["merge_frames"]
         dropped = duplicate & (rank > 0)  # the elder of each blob stays
-        keep = np.ones(len(self.ids), bool)
+        keep = np.ones(len(book), bool)
         keep[occluded[dropped]] = False
-        self._keep(keep)
+        book.keep(keep)
         return bool(dropped.any())
 
     def _surplus(self, occluded: np.ndarray, blob: np.ndarray, dets: np.ndarray) -> np.ndarray:
@@ -382,68 +381,24 @@ class Jpda(Tracker):
             return occluded
         occluded, blob, starts, rank = self._by_blob(occluded, blob)
         members = np.diff(np.r_[starts, len(occluded)])
-        mean_area = np.add.reduceat(self.sizes[occluded].prod(axis=1), starts) / members
+        mean_area = np.add.reduceat(self.book.boxes[occluded, 2:].prod(axis=1), starts) / members
         room = np.maximum(1, np.floor(dets[blob[starts], 2:4].prod(axis=1) / np.maximum(mean_area, 1e-9) + 0.5))
         return occluded[rank >= np.repeat(room, members)]
-
-    def _end_vanished(self) -> None:
-        """Targets vanished for vanish_frames frames leave the active set for the revival pool."""
-        gone = self.misses >= self.params["vanish_frames"]
-        e = self.ended
-        e["ids"] = np.r_[e["ids"], self.ids[gone]]
-        e["confirmed"] = np.r_[e["confirmed"], self.confirmed[gone]]
-        e["age"] = np.r_[e["age"], np.zeros(gone.sum(), np.int64)]
-        e["sizes"] = np.r_[e["sizes"], self.sizes[gone]]
-        e["bank"].x, e["bank"].P = np.r_[e["bank"].x, self.kf.x[gone]], np.r_[e["bank"].P, self.kf.P[gone]]
-        self._keep(~gone)
 
     def _revive(self, z: np.ndarray, dets: np.ndarray, unexplained: np.ndarray) -> np.ndarray:
         """Unexplained measurements that associate normally (uniquely, both ways) with a recently ended target
         bring it back; the others are returned as new targets."""
         e = self.ended
-        young = e["age"] <= self.params["revive_frames"]
-        for k in ("ids", "age", "sizes", "confirmed"):
-            e[k] = e[k][young]
-        e["bank"].keep(young)
-        if not len(unexplained) or not len(e["ids"]):
+        e.keep(e.age <= self.params["revive_frames"])
+        if not len(unexplained) or not len(e):
             return unexplained
-        gated = e["bank"].mahalanobis(z[unexplained]) <= self.gate
+        gated = e.kf.mahalanobis(z[unexplained]) <= self.gate
         unique = gated & (gated.sum(axis=0) == 1)[None, :] & (gated.sum(axis=1) == 1)[:, None]
         rows, cols = np.nonzero(unique)
-        if len(rows):
-            e["bank"].update(rows, z[unexplained[cols]])
-            self.ids = np.r_[self.ids, e["ids"][rows]]
-            self.misses = np.r_[self.misses, np.zeros(len(rows), np.int64)]
-            self.hits = np.r_[self.hits, np.zeros(len(rows), np.int64)]
-            self.confirmed = np.r_[self.confirmed, e["confirmed"][rows]]
-            self.age = np.r_[self.age, np.full(len(rows), self.params["vanish_frames"], np.int64)]
-            self.together = np.r_[self.together, np.zeros(len(rows), np.int64)]
-            self.sizes = np.r_[self.sizes, dets[unexplained[cols], 2:4]]
-            self.kf.x, self.kf.P = np.r_[self.kf.x, e["bank"].x[rows]], np.r_[self.kf.P, e["bank"].P[rows]]
-            keep = np.ones(len(e["ids"]), bool)
-            keep[rows] = False
-            for k in ("ids", "age", "sizes", "confirmed"):
-                e[k] = e[k][keep]
-            e["bank"].keep(keep)
+        e.kf.update(rows, z[unexplained[cols]])
+        e.move(rows, self.book, misses=0, streak=1, age=self.params["vanish_frames"],
+               boxes=dets[unexplained[cols], :4])
         return np.setdiff1d(unexplained, unexplained[cols])
-
-    def _add(self, z: np.ndarray, sizes: np.ndarray) -> None:
-        """New targets at the measurements, at rest (section 5, 2)."""
-        self.kf.add(z)
-        self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + len(z))]
-        self.next_id += len(z)
-        self.misses = np.r_[self.misses, np.zeros(len(z), np.int64)]
-        self.hits = np.r_[self.hits, np.zeros(len(z), np.int64)]
-        self.confirmed = np.r_[self.confirmed, np.zeros(len(z), bool)]
-        self.age = np.r_[self.age, np.zeros(len(z), np.int64)]
-        self.together = np.r_[self.together, np.zeros(len(z), np.int64)]
-        self.sizes = np.r_[self.sizes, sizes]
-
-    def _keep(self, mask: np.ndarray) -> None:
-        self.kf.keep(mask)
-        self.ids, self.misses, self.hits = self.ids[mask], self.misses[mask], self.hits[mask]
-        self.confirmed = self.confirmed[mask]
-        self.age, self.together, self.sizes = self.age[mask], self.together[mask], self.sizes[mask]
 
     def debug(self) -> list[dict]:
         """The last association's gate ellipses (d^2 = gate around each predicted centre), each target's motion
