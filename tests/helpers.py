@@ -57,17 +57,15 @@ def run_tracker(spec, env_id, config=None, seed=0, obs_mode="detections"):
 
     import mtt_sim  # noqa: F401  (registers the env ids)
     from mtt_sim import trackers
+    from mtt_sim.lab.episode import Episode
 
     registered = isinstance(env_id, str) and env_id.startswith("mtt_sim/")
     env = gym.make(env_id, obs_mode=obs_mode, config=config or {}) if registered else \
         TrackingEnv(env_id, config or {}, obs_mode=obs_mode)
-    obs, info = env.reset(seed=seed)
-    tracker = trackers.make(spec)
-    tracker.reset(info)
-    while True:
-        obs, _, term, trunc, info = env.step(tracker.update(obs).to_action(env.action_space))
-        if term or trunc:
-            return info["metrics"], tracker
+    episode = Episode(env, seed, trackers.make(spec))
+    for _ in episode:
+        pass
+    return env.unwrapped.metrics.summary(), episode.agent
 
 
 def fail_on_two(x):
