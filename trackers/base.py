@@ -110,10 +110,41 @@ class Param:
     default: Any
     allowed: str | tuple[str, ...] | None = None
     meaning: str = ""  # what it is, with its unit
+    search: tuple = ()  # where a tuner looks: (lo, hi) or (lo, hi, "log") for a number, the choices otherwise; () never
 
     def __post_init__(self):
         if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
             raise ValueError(f"Param allowed={self.allowed!r}: write an interval such as '[0, 1]' or '(0, inf)'")
+        if self.search and self.numeric:
+            lo, hi, *scale = self.search
+            if not (lo < hi and self._allows(lo) and self._allows(hi) and scale in ([], ["log"])
+                    and (not scale or lo > 0)):
+                raise ValueError(f"Param search={self.search!r}: a range (lo, hi) or (lo, hi, 'log') with lo < hi, both "
+                                 f"allowed ({self.allowed_text()}), lo > 0 on a log scale")
+        elif self.search and not all(self._allows(c) and type(c) is type(self.default) for c in self.search):
+            raise ValueError(f"Param search={self.search!r}: choices of the default's type, each allowed "
+                             f"({self.allowed_text()})")
+
+    @property
+    def numeric(self) -> bool:
+        return type(self.default) in (int, float)
+
+    def suggest(self, trial, key: str):
+        """This parameter's value for an Optuna trial, drawn from `search`."""
+        if not self.numeric:
+            return trial.suggest_categorical(key, list(self.search))
+        lo, hi, *scale = self.search
+        draw = trial.suggest_int if type(self.default) is int else trial.suggest_float
+        return draw(key, lo, hi, log=bool(scale))
+
+    def search_text(self) -> str:
+        """Where a tuner looks, for listings: '[1, 10]', '[0.01, 1] log', 'true, false'; '' where it does not."""
+        if not self.search:
+            return ""
+        if not self.numeric:
+            return ", ".join(str(c).lower() if isinstance(c, bool) else repr(c) for c in self.search)
+        lo, hi, *scale = self.search
+        return f"[{lo:g}, {hi:g}]" + (" log" if scale else "")
 
     def allowed_text(self) -> str:
         kind = type(self.default)
@@ -218,10 +249,17 @@ def available() -> dict[str, str]:
 
 
 def describe(name: str) -> list[str]:
-    """A registered tracker's parameters, a line each: name=default, the allowed values and what it means."""
+    """A registered tracker's parameters, a line each: name=default, the allowed values, what it means and, for a
+    tunable one, where a tuner looks."""
     return [f"{key + '=' + repr(param.default):34s} {param.allowed_text()}" + (f"; {param.meaning}" if param.meaning
                                                                                else "")
+            + (f"; tuned in {param.search_text()}" if param.search else "")
             for key, param in REGISTRY[name].parameters.items()]
+
+
+def search_space(name: str, fixed: Mapping = ()) -> dict[str, Param]:
+    """The tunable parameters of a registered tracker, less those `fixed` (given in its spec)."""
+    return {key: p for key, p in REGISTRY[name].parameters.items() if p.search and key not in fixed}
 
 
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
@@ -236,6 +274,15 @@ def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
             raise ValueError(f"tracker spec {spec!r}: parameter {key.strip()!r} is given twice")
         params[key.strip()] = value.strip()
     return name.strip(), params
+
+
+def spec_of(name: str, params: Mapping) -> str:
+    """The spec of tracker `name` with these parameters, the inverse of `parse_spec`: ('sort', {'max_age': 3}) ->
+    'sort:max_age=3'; floats written exactly, booleans as true and false."""
+    def text(value) -> str:
+        return str(value).lower() if isinstance(value, bool) else repr(value) if isinstance(value, float) else str(value)
+
+    return name + (":" + ",".join(f"{k}={text(v)}" for k, v in params.items()) if params else "")
 
 
 def split_specs(text: str) -> list[str]:

@@ -28,9 +28,9 @@ class ByteTrack(Tracker):
     name = "bytetrack"
     description = "ByteTrack (Zhang et al. 2022): two-stage association with high- and low-confidence detections"
     parameters = {
-        "track_thresh": Param(0.5, None, "confidence splitting high from low detections"),
-        "track_buffer": Param(30, "[0, inf)", "frames a lost track is kept (at 30 frames/s)"),
-        "match_thresh": Param(0.8, "[0, 1]", "largest cost (1 - IoU x score) of a first-round match"),
+        "track_thresh": Param(0.5, None, "confidence splitting high from low detections", (0.1, 0.95)),
+        "track_buffer": Param(30, "[0, inf)", "frames a lost track is kept (at 30 frames/s)", (1, 120, "log")),
+        "match_thresh": Param(0.8, "[0, 1]", "largest cost (1 - IoU x score) of a first-round match", (0.5, 0.99)),
         "mot20": Param(False, None, "the reference's MOT20 switch: no score fusion in the first round"),
         "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)")}
 

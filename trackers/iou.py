@@ -25,10 +25,10 @@ class IouTracker(Tracker):
     name = "iou"
     description = "IOU tracker (Bochinski et al. 2017): greedy IoU linking with sigma_l, sigma_h, sigma_iou, t_min"
     parameters = {
-        "sigma_l": Param(0.0, None, "detections below this confidence are dropped"),
-        "sigma_h": Param(0.5, None, "a track is kept only if its best confidence reaches this"),
-        "sigma_iou": Param(0.5, "[0, 1]", "least IoU linking a detection to a track"),
-        "t_min": Param(2, "[1, inf)", "least track length in frames")}
+        "sigma_l": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.9)),
+        "sigma_h": Param(0.5, None, "a track is kept only if its best confidence reaches this", (0.1, 0.99)),
+        "sigma_iou": Param(0.5, "[0, 1]", "least IoU linking a detection to a track", (0.1, 0.8)),
+        "t_min": Param(2, "[1, inf)", "least track length in frames", (1, 10))}
 
     def reset(self, info=None):
         self.key = np.zeros(0, np.int64)  # active tracks in the reference's order: creation number (the online id)

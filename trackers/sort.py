@@ -23,11 +23,11 @@ class Sort(Tracker):
     name = "sort"
     description = "SORT (Bewley et al. 2016): Kalman boxes + Hungarian IoU matching, min_hits, max_age"
     parameters = {
-        "max_age": Param(1, "[0, inf)", "frames a track is kept without a match"),
+        "max_age": Param(1, "[0, inf)", "frames a track is kept without a match", (1, 30)),
         "min_hits": Param(3, "[0, inf)", "matches in a row before a track is reported (from the first frames at "
-                                         "once, as the reference)"),
-        "iou_threshold": Param(0.3, "[0, 1]", "least IoU of a match"),
-        "min_confidence": Param(0.0, None, "detections below this confidence are dropped")}
+                                         "once, as the reference)", (0, 6)),
+        "iou_threshold": Param(0.3, "[0, 1]", "least IoU of a match", (0.05, 0.7)),
+        "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.95))}
 
     def reset(self, info=None):
         self.kf = KalmanBank(box_model())

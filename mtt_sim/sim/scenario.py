@@ -359,6 +359,15 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
     return sc
 
 
+def toml_scalar(value) -> str:
+    """A bool, string, int or float as TOML text (floats exactly, as repr writes them)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    return str(value) if isinstance(value, int) else repr(float(value))
+
+
 def read_sensor(path: str | Path) -> dict:
     """The [sensor] table of a TOML file (as `mtt-sim calibrate` writes), to be merged into a scenario's overrides."""
     path = Path(path)

@@ -465,9 +465,5 @@ def sensor_toml(sensor: dict, comments: Sequence[str] = ()) -> str:
 
 
 def toml_value(value) -> str:
-    """A scalar as TOML text."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return f'"{value}"'
-    return repr(float(value))
+    """A scalar as TOML text, numbers as floats (what the [sensor] table's keys are)."""
+    return scn.toml_scalar(value if isinstance(value, (bool, str)) else float(value))

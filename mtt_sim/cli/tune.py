@@ -1,0 +1,79 @@
+"""`mtt-sim tune`: an Optuna study of a tracker's parameters on scenarios, scenario files or sequence folders."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, add_overrides, episode_overrides, integer,
+                                   loaded, output_file, parse_seeds, replaced, require, scenario_keys, tracker_spec)
+
+
+def metric_goals(text: str) -> str:
+    """The --metric text, checked: metric names in any case, each with an optional + or - for its direction."""
+    from mtt_sim.metrics.goals import goals
+
+    try:
+        return ",".join(g.text for g in goals(text))
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("tune", help="tune a tracker's parameters (Optuna, TPE) on scenarios or sequences: the "
+                                           "best spec, its score beside the defaults', the best trials")
+    p.add_argument("spec", type=tracker_spec, help="the tracker spec to start from; parameters given in it stay fixed "
+                                                   "(lmb:reid=false)")
+    p.add_argument("--on", type=scenario_keys, required=True, metavar="SOURCE[,SOURCE...]",
+                   help="scenarios, scenario files or sequence folders; the score is the mean over them and the seeds")
+    p.add_argument("--metric", type=metric_goals, default="HOTA",
+                   help="what to optimise (default HOTA); several for a Pareto front, e.g. HOTA,-IDSW (counts of "
+                        "errors and distances are minimised unless marked +)")
+    p.add_argument("--trials", type=integer(1), default=50, help="trials in all, the defaults' first (default 50)")
+    p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1"),
+                   help="episode seeds per source: a count (3: seeds 0..2), a list or a range (default 1)")
+    p.add_argument("--seed", type=integer(0), default=0, help="the sampler's seed: one seed, one study (default 0)")
+    p.add_argument("--workers", type=integer(1), default=1, help="processes running a trial's episodes (default 1)")
+    p.add_argument("--backend", choices=("local", "ray"), default="local",
+                   help="local processes, or Ray tasks for a trial's episodes (the [ray] extra; --address for a cluster)")
+    p.add_argument("--address", help="with --backend ray: a Ray cluster's address")
+    p.add_argument("--storage", help="an Optuna storage URL, e.g. sqlite:///study.db: the study is kept there and "
+                                     "resumed by the same command")
+    p.add_argument("--study-name", help="the study's name in --storage (default: the tracker and the sources)")
+    p.add_argument("--time-budget", type=integer(1), metavar="SECONDS", help="stop starting trials after this long")
+    p.add_argument("--out", help="write the result as TOML: the spec, its score, the defaults' and the parameters")
+    p.add_argument("--plot", help="write the optimisation history as a PNG, and the parameters' importances beside "
+                                  "it (<name>_importances.png; the [plot] extra)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_overrides(p, CONFIG_HELP)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    require("optuna", "tune", "tune")
+    overrides = episode_overrides(args)
+    loaded(args.on, overrides)
+    out = output_file(args.out, args.force, "--out", (".toml",))
+    plot = output_file(args.plot, args.force, "--plot", (".png",))
+    if plot:
+        require("matplotlib", "--plot", "plot")
+    from mtt_sim.lab import tune
+
+    result, study = tune.tune(args.spec, args.on, args.metric, args.trials, args.seeds, overrides, args.seed,
+                              args.workers, args.storage, args.study_name, args.time_budget, progress=not args.json,
+                              backend=args.backend, address=args.address)
+    if out:
+        out.write_text(result.toml())
+    if plot:
+        tune.plot(study, result.goals, plot)
+    if args.json:
+        print(json.dumps(result.as_dict()))
+        return 0
+    print(tune.report(result, study))
+    for path, what in ((out, "result"), (plot, "plots")):
+        if path:
+            print(f"{what}: {path}" + (f" and {Path(path).stem}_importances.png" if what == "plots" else "")
+                  + replaced(args.force))
+    return 0

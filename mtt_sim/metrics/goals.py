@@ -1,0 +1,39 @@
+"""Which way each metric is better, and a list of metrics to optimise read from text such as 'HOTA,-IDSW'."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mtt_sim.metrics.episode import METRICS
+
+LOWER_IS_BETTER = {"FP", "FN", "IDSW", "Frag", "ML", "IDFP", "IDFN", "GOSPA", "CentreError", "CentreErrorVar",
+                   "HiddenCentreError"}  # counts of errors and distances; every other metric is better higher
+
+
+@dataclass(frozen=True)
+class Goal:
+    """One metric to optimise and its direction."""
+
+    metric: str
+    maximize: bool
+
+    @property
+    def text(self) -> str:
+        return self.metric if self.maximize != (self.metric in LOWER_IS_BETTER) else \
+            ("+" if self.maximize else "-") + self.metric
+
+
+def goals(text: str) -> list[Goal]:
+    """'HOTA' or 'HOTA,-IDSW': each metric in its natural direction (higher is better but for counts of errors and
+    distances), or as its sign says."""
+    names = {m.lower(): m for m in METRICS}
+    out = []
+    for item in filter(None, (i.strip() for i in text.split(","))):
+        sign, name = (item[0], item[1:]) if item[0] in "+-" else ("", item)
+        if name.lower() not in names:
+            raise ValueError(f"unknown metric {name!r}; available: {', '.join(METRICS)}")
+        metric = names[name.lower()]
+        out.append(Goal(metric, sign == "+" or (not sign and metric not in LOWER_IS_BETTER)))
+    if not out or len({g.metric for g in out}) != len(out):
+        raise ValueError(f"metrics {text!r}: one or more, each once, e.g. HOTA or HOTA,-IDSW")
+    return out
