@@ -155,6 +155,106 @@ def test_every_numeric_parameter_has_a_range():
             assert param.check(name, key, param.default) == param.default, (name, key)
 
 
+# ------------------------------------------------------------------ where a tuner looks
+
+NEVER_TUNED = {"seed", "frame_rate", "reid", "reid_metric", "birth_rule", "blob_report", "propagate", "interactive"}
+
+
+def _search_values(param):
+    """A tunable parameter's values to try: its range's ends and middle (geometric on a log scale), or its choices."""
+    if not param.numeric:
+        return list(param.search)
+    lo, hi, *scale = param.search
+    middle = (lo * hi) ** 0.5 if scale else (lo + hi) / 2
+    return [lo, round(middle) if type(param.default) is int else middle, hi]
+
+
+def _at(name, end):
+    """Every tunable parameter of tracker `name` at the low (0) or high (-1) end of its range or choices."""
+    return {key: p.search[1 if end and p.numeric else end] for key, p in trackers.base.search_space(name).items()}
+
+
+@pytest.mark.parametrize("name", sorted(trackers.available()))
+def test_search_ranges_hold_their_default_and_make_trackers_that_run(name):
+    """Each searched value makes a tracker; with every parameter at one end of its range, the tracker runs 10 frames
+    of Crossing (a tuner's corners are where the arithmetic breaks first)."""
+    for key, p in trackers.base.search_space(name).items():
+        assert key not in NEVER_TUNED, (name, key)
+        if p.numeric:
+            assert p.search[0] <= p.default <= p.search[1], (name, key, p.search)
+            assert type(p.default) is float or all(type(v) is int for v in p.search[:2]), (name, key)  # suggest_int
+        else:
+            assert p.default in p.search, (name, key, p.search)
+        for value in _search_values(p):
+            assert trackers.make(name, **{key: value}).params[key] == value, (name, key, value)
+    for end in (0, -1):
+        tracker = trackers.make(name, **_at(name, end))
+        env = gym.make("mtt_sim/Crossing-v0", obs_mode="frame+detections" if tracker.needs_frame else "detections")
+        episode = Episode(env, 0, tracker, steps=10)
+        for _ in episode:
+            pass
+        assert episode.steps == 10
+        env.close()
+
+
+def test_the_trackers_of_the_paper_comparisons_are_tunable():
+    """The trackers the tuner is for each have a search space, and the model gmphd and lmb share is searched alike."""
+    for name in ("gnn", "gmphd", "lmb", "jpda", "jpda_exact", "pf", "ipf", "pcpf", "sort", "bytetrack", "iou"):
+        assert trackers.base.search_space(name), name
+    gmphd, lmb = (trackers.base.REGISTRY[n].parameters for n in ("gmphd", "lmb"))
+    assert all(gmphd[k].search == lmb[k].search != () for k in trackers.gaussian_mixture.MODEL_PARAMETERS)
+    assert trackers.base.search_space("jpda_exact") == trackers.base.search_space("jpda")  # its caps are not tuned
+    assert "conflict_ratio" in trackers.base.search_space("ipf")
+    assert "conflict_ratio" not in trackers.base.search_space("pcpf")  # unread without the interaction
+
+
+BAD_SEARCH = [
+    (0.5, "[0, 1]", (0.7, 0.3)),            # lo > hi
+    (0.5, "[0, 1]", (0.5, 0.5)),            # lo == hi
+    (0.5, "[0, 1]", (0.0, 2.0)),            # hi outside the allowed values
+    (0.5, "(0, 1]", (0.0, 1.0)),            # lo on an excluded end
+    (3, "[1, inf)", (0, 5)),                # an int below its allowed values
+    (1.0, "[0, inf)", (0.0, 10.0, "log")),  # a log scale from 0
+    (0.0, None, (-1.0, 1.0, "log")),        # a log scale from below 0
+    (1.0, None, (0.1, 10.0, "ln")),         # an unknown scale
+    (1.0, None, (0.1, 10.0, "log", 2)),     # too many entries
+    (True, None, (1, 0)),                   # ints for a bool
+    (True, None, (True, "false")),          # text for a bool
+    ("a", ("a", "b"), ("a", "c")),          # a choice not allowed
+    ("a", ("a", "b"), ("a", 1)),            # a number for a string
+]
+
+
+@pytest.mark.parametrize("default, allowed, search", BAD_SEARCH)
+def test_a_bad_search_range_is_refused_naming_search(default, allowed, search):
+    with pytest.raises(ValueError, match=r"Param search="):
+        trackers.Param(default, allowed, "a test parameter", search)
+
+
+def test_good_search_ranges_are_accepted():
+    assert trackers.Param(0.5, "[0, 1]", "", (0.0, 1.0)).search_text() == "[0, 1]"
+    assert trackers.Param(5, "[1, inf)", "", (1, 60, "log")).search_text() == "[1, 60] log"
+    assert trackers.Param(True, None, "", (True, False)).search_text() == "true, false"
+    assert trackers.Param("a", ("a", "b"), "", ("b", "a")).search_text() == "'b', 'a'"
+    assert trackers.Param(1.0).search == () and trackers.Param(1.0).search_text() == ""
+
+
+def test_search_space_leaves_out_fixed_parameters_and_those_without_a_range():
+    jpda = trackers.base.REGISTRY["jpda"].parameters
+    unranged = {k for k, p in jpda.items() if not p.search}
+    assert {"k", "situations", "blob_report", "coast"} <= unranged
+    whole = trackers.base.search_space("jpda")
+    assert list(whole) == [k for k in jpda if k not in unranged]  # in the parameters' order
+    assert all(whole[k] is jpda[k] for k in whole)
+    name, fixed = trackers.parse_spec("jpda:pd=0.8,clutter_density=1e-6,k=3")
+    space = trackers.base.search_space(name, fixed)
+    assert set(space) == set(whole) - {"pd", "clutter_density"}
+    assert trackers.base.search_space("jpda", ["min_hits"]).keys() == whole.keys() - {"min_hits"}
+    assert trackers.base.search_space("echo") == {}
+    every = set(trackers.base.REGISTRY["gnn"].parameters)
+    assert trackers.base.search_space("gnn", dict.fromkeys(every, 1)) == {}
+
+
 GOOD = np.array([[10, 10, 5, 8, 0.9], [30, 30, 6, 6, 0.5], [0, 0, 0, 0, 0]], np.float32)
 FRAME = np.zeros((40, 60, 3), np.uint8)
 

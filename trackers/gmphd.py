@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from . import gaussian_mixture as gm
@@ -27,12 +29,19 @@ class GaussianMixturePhd(Tracker):
     name = "gmphd"
     description = "GM-PHD filter (Vo and Ma 2006), measurement-driven birth, labels tagged through updates"
     parameters = {
-        **gm.MODEL_PARAMETERS,
-        "birth_weight": Param(0.3, "(0, inf)", "newborn weight per unexplained detection (times its confidence)"),
+        **gm.MODEL_PARAMETERS,  # the model lmb shares, with where a tuner looks (the same ranges as lmb's):
+        "survival": replace(gm.MODEL_PARAMETERS["survival"], search=(0.9, 0.999)),
+        "detection": replace(gm.MODEL_PARAMETERS["detection"], search=(0.4, 0.98)),
+        "clutter_rate": replace(gm.MODEL_PARAMETERS["clutter_rate"], search=(0.5, 50.0, "log")),
+        "gate": replace(gm.MODEL_PARAMETERS["gate"], search=(0.9, 0.9999)),
+        "measurement_noise": replace(gm.MODEL_PARAMETERS["measurement_noise"], search=(0.05, 0.6, "log")),
+        "process_noise": replace(gm.MODEL_PARAMETERS["process_noise"], search=(0.002, 0.1, "log")),
+        "birth_weight": Param(0.3, "(0, inf)", "newborn weight per unexplained detection (times its confidence)",
+                              (0.03, 1.0, "log")),
         "prune": Param(1e-4, "[0, 1)", "components lighter than this are dropped"),
-        "merge": Param(4.0, "[0, inf)", "Mahalanobis distance within which components merge"),
+        "merge": Param(4.0, "[0, inf)", "Mahalanobis distance within which components merge", (1.0, 16.0, "log")),
         "max_components": Param(200, "[1, inf)", "most components kept"),
-        "extract": Param(0.5, "(0, inf)", "least weight of a reported state")}
+        "extract": Param(0.5, "(0, inf)", "least weight of a reported state", (0.2, 0.9))}
 
     def reset(self, info=None):
         size = (info or {}).get("image_size")

@@ -22,13 +22,14 @@ class Gnn(Tracker):
     name = "gnn"
     description = "Global nearest neighbour: Kalman centres, chi-square gating, Hungarian on Mahalanobis distance"
     parameters = {
-        "gate_probability": Param(0.99, "(0, 1)", "probability that the gate holds a target's own measurement"),
-        "min_hits": Param(3, "[0, inf)", "hits before a track is reported"),
-        "max_age": Param(5, "[0, inf)", "misses before a confirmed track ends"),
-        "accel_sigma": Param(0.5, "[0, inf)", "white acceleration, px/frame^2"),
-        "meas_sigma": Param(2.0, "(0, inf)", "detection centre noise, px"),
-        "coast": Param(False, None, "report confirmed tracks through their misses"),
-        "min_confidence": Param(0.0, None, "detections below this confidence are dropped")}
+        "gate_probability": Param(0.99, "(0, 1)", "probability that the gate holds a target's own measurement",
+                                  (0.9, 0.9999)),
+        "min_hits": Param(3, "[0, inf)", "hits before a track is reported", (1, 8)),
+        "max_age": Param(5, "[0, inf)", "misses before a confirmed track ends", (1, 60, "log")),
+        "accel_sigma": Param(0.5, "[0, inf)", "white acceleration, px/frame^2", (0.05, 5.0, "log")),
+        "meas_sigma": Param(2.0, "(0, inf)", "detection centre noise, px", (1.0, 50.0, "log")),
+        "coast": Param(False, None, "report confirmed tracks through their misses", (False, True)),
+        "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.9))}
 
     def reset(self, info=None):
         p = self.params

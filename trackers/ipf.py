@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from .appearance import bhattacharyya, histograms, hs_bins
@@ -61,10 +63,10 @@ class InteractiveParticleFilter(Tracker):
     parameters = {
         "particles": Param(100, "[1, 100000]", "particles per target"),
         "conflict_ratio": Param(0.75, "(0, 1]", "overlap (of the smaller box) that puts two targets' particles in "
-                                                "conflict"),
-        "sigma2": Param(0.045, "(0, inf)", "variance of the colour likelihood (eq. 6)"),
-        "h_levels": Param(16, "[2, 180]", "hue histogram levels"),
-        "s_levels": Param(16, "[2, 256]", "saturation histogram levels"),
+                                                "conflict", (0.3, 0.95)),
+        "sigma2": Param(0.045, "(0, inf)", "variance of the colour likelihood (eq. 6)", (0.005, 0.5, "log")),
+        "h_levels": Param(16, "[2, 180]", "hue histogram levels", (4, 64, "log")),
+        "s_levels": Param(16, "[2, 256]", "saturation histogram levels", (4, 64, "log")),
         "interactive": Param(True, None, "reweight conflicting particles (false: independent filters)"),
         "samples": Param(256, "[0, inf)", "pixels sampled per region for its histogram (0: all)"),
         "propagate": Param("estimate", ("estimate", "resample"),
@@ -166,9 +168,11 @@ class PathConsistencyParticleFilter(InteractiveParticleFilter):
         **InteractiveParticleFilter.parameters,
         "particles": Param(200, "[1, 100000]", "particles per target (the paper's count for this baseline)"),
         "interactive": Param(False, None, "off: independent filters, the baseline"),
+        # read only when interactive: not tuned here
+        "conflict_ratio": replace(InteractiveParticleFilter.parameters["conflict_ratio"], search=()),
         "occluded_distance": Param(0.3, "[0, 1]", "a target whose best particle is farther than this is occluded and "
-                                                  "coasts"),
-        "velocity_gain": Param(0.3, "[0, 1]", "how fast the velocity follows the estimates")}
+                                                  "coasts", (0.05, 0.8)),
+        "velocity_gain": Param(0.3, "[0, 1]", "how fast the velocity follows the estimates", (0.05, 0.9))}
 
     def reset(self, info=None):
         super().reset(info)

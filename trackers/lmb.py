@@ -4,6 +4,7 @@ Murty-ranked association hypotheses, and a birth model driven by the detections 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -146,7 +147,13 @@ class LabelledMultiBernoulli(Tracker):
     description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id " \
                   "(Jiang and Yang)"
     parameters = {
-        **gm.MODEL_PARAMETERS,
+        **gm.MODEL_PARAMETERS,  # the model gmphd shares, with where a tuner looks (the same ranges as gmphd's):
+        "survival": replace(gm.MODEL_PARAMETERS["survival"], search=(0.9, 0.999)),
+        "detection": replace(gm.MODEL_PARAMETERS["detection"], search=(0.4, 0.98)),
+        "clutter_rate": replace(gm.MODEL_PARAMETERS["clutter_rate"], search=(0.5, 50.0, "log")),
+        "gate": replace(gm.MODEL_PARAMETERS["gate"], search=(0.9, 0.9999)),
+        "measurement_noise": replace(gm.MODEL_PARAMETERS["measurement_noise"], search=(0.05, 0.6, "log")),
+        "process_noise": replace(gm.MODEL_PARAMETERS["process_noise"], search=(0.002, 0.1, "log")),
         "hypotheses": Param(15, "[1, inf)", "best association hypotheses per group (Murty)"),
         "birth": Param("adaptive", ("adaptive", "fixed"), "adaptive: births from unexplained detections by "
                                                           "confidence (the paper); fixed: along the borders"),
@@ -157,10 +164,10 @@ class LabelledMultiBernoulli(Tracker):
                             "associated"),
         "birth_rate": Param(1.0, "(0, inf)", "lambda_B of birth_rule=reuter: expected newborn targets a frame"),
         "birth_max": Param(0.6, "(0, 1)", "largest newborn existence probability (a fully confident, unexplained "
-                                          "detection)"),
+                                          "detection)", (0.1, 0.95)),
         "fixed_births": Param(16, "[1, inf)", "newborn components a frame with birth=fixed"),
         "fixed_birth_r": Param(0.03, "(0, 1)", "their existence probability"),
-        "extract": Param(0.5, "(0, 1)", "least existence probability of a reported track"),
+        "extract": Param(0.5, "(0, 1)", "least existence probability of a reported track", (0.2, 0.9)),
         "coast": Param(True, None, "report tracks through frames they are missed; false (an ablation, not the "
                                    "paper): only tracks that took a measurement this frame"),
         "prune": Param(1e-3, "[0, 1)", "tracks less likely than this are dropped"),
@@ -169,8 +176,9 @@ class LabelledMultiBernoulli(Tracker):
                                                 "drops them)"),
         "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
         "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
-        "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool"),
-        "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification"),
+        "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool",
+                                 (0.3, 0.95)),
+        "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log")),
         "pool_per_target": Param(10, "[1, inf)", "pooled features per target of the first frame"),
         "pool_every": Param(10, "[1, inf)", "frames between pool updates"),
         "reid_metric": Param("", None, "an XQDA metric file from mtt-sim learn-reid (empty: the shipped one)")}

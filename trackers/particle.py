@@ -74,14 +74,15 @@ class ColourTextureParticleFilter(Tracker):
                   "hand-initialised)"
     parameters = {
         "particles": Param(60, "[1, 100000]", "particles per target"),
-        "alpha": Param(0.6, "[0, 1]", "weight of colour against texture in the fused likelihood"),
-        "lam": Param(20.0, "(0, inf)", "colour likelihood exp(-lam d^2) (the paper: 0.02)"),
-        "mu": Param(10.0, "(0, inf)", "texture likelihood exp(-mu e^2) (the paper: 0.01)"),
-        "beta": Param(0.9, "[0, 1]", "template memory in the update (eq. 9-10)"),
-        "update_threshold": Param(0.3, "[0, 1]", "least likelihood of the estimate for a template update"),
-        "pos_sigma": Param(3.0, "[0, inf)", "position noise per frame, px"),
-        "vel_sigma": Param(1.0, "[0, inf)", "velocity noise per frame, px/frame"),
-        "levels": Param(16, "[2, 64]", "histogram levels per colour channel"),
+        "alpha": Param(0.6, "[0, 1]", "weight of colour against texture in the fused likelihood", (0.0, 1.0)),
+        "lam": Param(20.0, "(0, inf)", "colour likelihood exp(-lam d^2) (the paper: 0.02)", (4.0, 200.0, "log")),
+        "mu": Param(10.0, "(0, inf)", "texture likelihood exp(-mu e^2) (the paper: 0.01)", (2.0, 50.0, "log")),
+        "beta": Param(0.9, "[0, 1]", "template memory in the update (eq. 9-10)", (0.5, 1.0)),
+        "update_threshold": Param(0.3, "[0, 1]", "least likelihood of the estimate for a template update",
+                                  (0.05, 0.9)),
+        "pos_sigma": Param(3.0, "[0, inf)", "position noise per frame, px", (1.0, 30.0, "log")),
+        "vel_sigma": Param(1.0, "[0, inf)", "velocity noise per frame, px/frame", (0.2, 10.0, "log")),
+        "levels": Param(16, "[2, 64]", "histogram levels per colour channel", (4, 32, "log")),
         "seed": Param(0, "[0, inf)", "the particles' random seed")}
     needs_frame = True
 
