@@ -222,6 +222,9 @@ BAD_SEARCH = [
     (True, None, (True, "false")),          # text for a bool
     ("a", ("a", "b"), ("a", "c")),          # a choice not allowed
     ("a", ("a", "b"), ("a", 1)),            # a number for a string
+    (1.0, None, ("a", "b")),                # text for a number
+    (1, "[0, inf)", (1.5, 6)),              # a fraction for an int
+    (5, "[0, inf)", (5,)),                  # one end only
 ]
 
 

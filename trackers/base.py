@@ -116,11 +116,13 @@ class Param:
         if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
             raise ValueError(f"Param allowed={self.allowed!r}: write an interval such as '[0, 1]' or '(0, inf)'")
         if self.search and self.numeric:
-            lo, hi, *scale = self.search
-            if not (lo < hi and self._allows(lo) and self._allows(hi) and scale in ([], ["log"])
-                    and (not scale or lo > 0)):
-                raise ValueError(f"Param search={self.search!r}: a range (lo, hi) or (lo, hi, 'log') with lo < hi, both "
-                                 f"allowed ({self.allowed_text()}), lo > 0 on a log scale")
+            kinds = (int,) if type(self.default) is int else (int, float)
+            ends, scale = self.search[:2], list(self.search[2:])
+            if not (len(ends) == 2 and all(type(e) in kinds for e in ends) and ends[0] < ends[1]
+                    and all(map(self._allows, ends)) and scale in ([], ["log"]) and (not scale or ends[0] > 0)):
+                raise ValueError(f"Param search={self.search!r}: a range (lo, hi) or (lo, hi, 'log') of "
+                                 f"{'integers' if kinds == (int,) else 'numbers'} with lo < hi, both allowed "
+                                 f"({self.allowed_text()}), lo > 0 on a log scale")
         elif self.search and not all(self._allows(c) and type(c) is type(self.default) for c in self.search):
             raise ValueError(f"Param search={self.search!r}: choices of the default's type, each allowed "
                              f"({self.allowed_text()})")

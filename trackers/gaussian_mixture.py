@@ -18,12 +18,13 @@ DIM, MEAS = 8, 4
 # the model parameters the LMB and GM-PHD trackers share; noise values chosen on mot17_like seed 100 (not one
 # of the experiments' seeds 0..9)
 MODEL_PARAMETERS = {
-    "survival": Param(0.98, "(0, 1]", "probability a target survives a frame"),
-    "detection": Param(0.75, "(0, 1]", "detection probability P_D"),
-    "clutter_rate": Param(5.0, "(0, inf)", "false detections per frame"),
-    "gate": Param(0.99, "(0, 1)", "chi-square gate probability"),
-    "measurement_noise": Param(0.15, "(0, inf)", "detection noise, as a fraction of the box size"),
-    "process_noise": Param(0.01, "(0, inf)", "motion noise per frame, as a fraction of the box size")}
+    "survival": Param(0.98, "(0, 1]", "probability a target survives a frame", (0.9, 0.999)),
+    "detection": Param(0.75, "(0, 1]", "detection probability P_D", (0.4, 0.98)),
+    "clutter_rate": Param(5.0, "(0, inf)", "false detections per frame", (0.5, 50.0, "log")),
+    "gate": Param(0.99, "(0, 1)", "chi-square gate probability", (0.9, 0.9999)),
+    "measurement_noise": Param(0.15, "(0, inf)", "detection noise, as a fraction of the box size", (0.05, 0.6, "log")),
+    "process_noise": Param(0.01, "(0, inf)", "motion noise per frame, as a fraction of the box size",
+                           (0.002, 0.1, "log"))}
 F = np.eye(DIM) + np.eye(DIM, k=MEAS)
 H = np.eye(MEAS, DIM)
 

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 
 import numpy as np
 
@@ -29,13 +28,7 @@ class GaussianMixturePhd(Tracker):
     name = "gmphd"
     description = "GM-PHD filter (Vo and Ma 2006), measurement-driven birth, labels tagged through updates"
     parameters = {
-        **gm.MODEL_PARAMETERS,  # the model lmb shares, with where a tuner looks (the same ranges as lmb's):
-        "survival": replace(gm.MODEL_PARAMETERS["survival"], search=(0.9, 0.999)),
-        "detection": replace(gm.MODEL_PARAMETERS["detection"], search=(0.4, 0.98)),
-        "clutter_rate": replace(gm.MODEL_PARAMETERS["clutter_rate"], search=(0.5, 50.0, "log")),
-        "gate": replace(gm.MODEL_PARAMETERS["gate"], search=(0.9, 0.9999)),
-        "measurement_noise": replace(gm.MODEL_PARAMETERS["measurement_noise"], search=(0.05, 0.6, "log")),
-        "process_noise": replace(gm.MODEL_PARAMETERS["process_noise"], search=(0.002, 0.1, "log")),
+        **gm.MODEL_PARAMETERS,  # the model lmb shares, with where a tuner looks
         "birth_weight": Param(0.3, "(0, inf)", "newborn weight per unexplained detection (times its confidence)",
                               (0.03, 1.0, "log")),
         "prune": Param(1e-4, "[0, 1)", "components lighter than this are dropped"),

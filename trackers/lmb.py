@@ -4,7 +4,6 @@ Murty-ranked association hypotheses, and a birth model driven by the detections 
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
@@ -147,13 +146,7 @@ class LabelledMultiBernoulli(Tracker):
     description = "Labelled multi-Bernoulli filter, Murty-ranked hypotheses, confidence-driven birth, re-id " \
                   "(Jiang and Yang)"
     parameters = {
-        **gm.MODEL_PARAMETERS,  # the model gmphd shares, with where a tuner looks (the same ranges as gmphd's):
-        "survival": replace(gm.MODEL_PARAMETERS["survival"], search=(0.9, 0.999)),
-        "detection": replace(gm.MODEL_PARAMETERS["detection"], search=(0.4, 0.98)),
-        "clutter_rate": replace(gm.MODEL_PARAMETERS["clutter_rate"], search=(0.5, 50.0, "log")),
-        "gate": replace(gm.MODEL_PARAMETERS["gate"], search=(0.9, 0.9999)),
-        "measurement_noise": replace(gm.MODEL_PARAMETERS["measurement_noise"], search=(0.05, 0.6, "log")),
-        "process_noise": replace(gm.MODEL_PARAMETERS["process_noise"], search=(0.002, 0.1, "log")),
+        **gm.MODEL_PARAMETERS,  # the model gmphd shares, with where a tuner looks
         "hypotheses": Param(15, "[1, inf)", "best association hypotheses per group (Murty)"),
         "birth": Param("adaptive", ("adaptive", "fixed"), "adaptive: births from unexplained detections by "
                                                           "confidence (the paper); fixed: along the borders"),

@@ -132,11 +132,13 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
 
 
 def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, backend: str = "local",
-              address: str | None = None, on_record: Callable[[dict], None] | None = None) -> list[dict]:
-    """Episodes (scenario, tracker, seed, config, results file or None) as `run_grid` runs them; records in order."""
+              address: str | None = None, on_record: Callable[[dict], None] | None = None,
+              processes: pool.Pool | None = None) -> list[dict]:
+    """Episodes (scenario, tracker, seed, config, results file or None) as `run_grid` runs them; records in order.
+    `processes` (from `episode_pool`) runs them in workers already started, instead of `workers` new ones."""
     records: list = [None] * len(tasks)
     with tqdm(total=len(tasks), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
-        for i, record in _finished(tasks, workers, backend, address):
+        for i, record in _finished(tasks, workers, backend, address, processes):
             records[i] = record
             if on_record:
                 on_record(record)
@@ -157,15 +159,22 @@ def results_path(folder: str | Path, tracker: str, scenario: str, seed: int | No
     return path
 
 
-def _finished(tasks: list, workers: int, backend: str, address: str | None) -> Iterator[tuple[int, dict]]:
+def episode_pool(workers: int) -> pool.Pool:
+    """Worker processes that run grid episodes, kept for several `run_tasks` calls (a tuning study's trials)."""
+    return pool.Pool(_task, workers)
+
+
+def _finished(tasks: list, workers: int, backend: str, address: str | None,
+              processes: pool.Pool | None = None) -> Iterator[tuple[int, dict]]:
     """(index, record) of every task as it finishes."""
     if backend == "ray":
         yield from _on_ray(tasks, workers, address)
-    elif workers <= 1:
+    elif processes is None and workers <= 1:
         for i, task in enumerate(tasks):
             yield i, _task(task)
     else:
-        for i, value in pool.run(_task, tasks, workers):
+        done = processes.run(tasks) if processes is not None else pool.run(_task, tasks, workers)
+        for i, value in done:
             yield i, failed_record(tasks[i], value.message) if isinstance(value, pool.TaskFailed) else value
 
 

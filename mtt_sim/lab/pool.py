@@ -32,33 +32,57 @@ class TaskFailed:
 def run(fn: Callable[[Any], Any], tasks: Sequence, workers: int) -> Iterator[tuple[int, Any]]:
     """Yield (index, fn(tasks[index]) or TaskFailed) as the tasks finish, in `workers` spawned processes. Closing the
     iterator early (an exception in the caller, Ctrl-C) stops the workers."""
-    ctx = multiprocessing.get_context("spawn")
-    pool = [_Worker(ctx, fn) for _ in range(min(workers, len(tasks)))]
-    todo = deque(range(len(tasks)))
-    finished = False
-    try:
-        while todo or any(w.task is not None for w in pool):
-            for k, w in enumerate(pool):
-                if w.task is None and todo:
-                    if not w.process.is_alive():  # died while idle: replace it before giving it a task
-                        pool[k] = w = _Worker(ctx, fn)
-                    w.give(todo.popleft(), tasks)
-            busy = {w.results: w for w in pool if w.task is not None}
-            for conn in wait(list(busy)):
-                w = busy[conn]
-                try:
-                    index, value = conn.recv()
-                except (EOFError, OSError):  # the pipe closed: the worker died inside its task
-                    w.process.join(timeout=5)
-                    index, value = w.task, TaskFailed(f"worker process died (exit code {w.process.exitcode})")
-                    w.stop(wait=False)
-                    pool[pool.index(w)] = _Worker(ctx, fn)
-                w.task = None
-                yield index, value
-        finished = True
-    finally:
-        for w in pool:
-            w.stop(wait=finished)
+    with Pool(fn, min(workers, len(tasks))) as pool:
+        yield from pool.run(tasks)
+
+
+class Pool:
+    """`workers` spawned processes running `fn`, kept from one batch of tasks to the next (a tuning study's trials pay
+    for starting them once); `close` (or leaving a `with` block) stops them."""
+
+    def __init__(self, fn: Callable[[Any], Any], workers: int):
+        self.ctx, self.fn = multiprocessing.get_context("spawn"), fn
+        self.workers = [_Worker(self.ctx, fn) for _ in range(workers)]
+
+    def run(self, tasks: Sequence) -> Iterator[tuple[int, Any]]:
+        """Yield (index, fn(tasks[index]) or TaskFailed) as the tasks finish. Closing the iterator early stops the
+        workers: the pool is then spent."""
+        pool, todo, finished = self.workers, deque(range(len(tasks))), False
+        try:
+            while todo or any(w.task is not None for w in pool):
+                for k, w in enumerate(pool):
+                    if w.task is None and todo:
+                        if not w.process.is_alive():  # died while idle: replace it before giving it a task
+                            pool[k] = w = _Worker(self.ctx, self.fn)
+                        w.give(todo.popleft(), tasks)
+                busy = {w.results: w for w in pool if w.task is not None}
+                for conn in wait(list(busy)):
+                    w = busy[conn]
+                    try:
+                        index, value = conn.recv()
+                    except (EOFError, OSError):  # the pipe closed: the worker died inside its task
+                        w.process.join(timeout=5)
+                        index, value = w.task, TaskFailed(f"worker process died (exit code {w.process.exitcode})")
+                        w.stop(wait=False)
+                        pool[pool.index(w)] = _Worker(self.ctx, self.fn)
+                    w.task = None
+                    yield index, value
+            finished = True
+        finally:
+            if not finished:
+                self.close(wait=False)
+
+    def close(self, wait: bool = True) -> None:
+        """Stop the workers: let idle ones leave (`wait`), else terminate them."""
+        for w in self.workers:
+            w.stop(wait=wait)
+        self.workers = []
+
+    def __enter__(self) -> "Pool":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close(wait=exc[0] is None)
 
 
 class _Worker:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
 from mtt_sim import trackers
-from mtt_sim.lab.experiment import run_tasks
+from mtt_sim.lab.experiment import episode_pool, run_tasks
 from mtt_sim.metrics.goals import Goal, goals
 from mtt_sim.sim.scenario import toml_scalar
 from mtt_sim.trackers.base import parse_spec, search_space, spec_of
@@ -81,7 +81,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
         values = []
         for step, source in enumerate(sources):
             tasks = [(source, trial_spec, s, dict(config or {}), None) for s in seeds]
-            records = run_tasks(tasks, workers, backend=backend, address=address)
+            records = run_tasks(tasks, workers, backend=backend, address=address, processes=processes)
             failed = [r["error"] for r in records if r["error"]]
             if failed:
                 trial.set_user_attr("error", failed[0])
@@ -94,7 +94,13 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
         return tuple(_mean(values, k) for k in range(len(wanted)))
 
     remaining = max(0, trials - sum(t.state.is_finished() for t in study.trials))  # the enqueued defaults wait
-    study.optimize(objective, n_trials=remaining, timeout=time_budget, catch=(Exception,), show_progress_bar=progress)
+    processes = episode_pool(workers) if workers > 1 and backend == "local" else None  # started once for every trial
+    try:
+        study.optimize(objective, n_trials=remaining, timeout=time_budget, catch=(Exception,),
+                       show_progress_bar=progress)
+    finally:
+        if processes is not None:
+            processes.close()
     return _result(study, name, fixed, wanted), study
 
 
