@@ -107,3 +107,5 @@ def test_the_command_prints_json_writes_toml_and_refuses_a_bad_metric(tmp_path, 
     with pytest.raises(SystemExit) as exit_:
         cli.main(["tune", "sort", "--on", "crossing", "--metric", "HOTTA"])
     assert exit_.value.code == 2 and "unknown metric 'HOTTA'" in capsys.readouterr().err
+    assert cli.main(["tune", "sort", "--on", "crossing", "--storage", "nowhere", "--trials", "2"]) == 2
+    assert "storage 'nowhere': Could not parse" in capsys.readouterr().err

@@ -67,7 +67,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
     wanted = goals(metric)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     study = optuna.create_study(
-        storage=storage, study_name=study_name or f"{tracker.name} on {','.join(map(str, sources))}",
+        storage=_storage(storage), study_name=study_name or f"{tracker.name} on {','.join(map(str, sources))}",
         load_if_exists=True, directions=["maximize" if g.maximize else "minimize" for g in wanted],
         sampler=optuna.samplers.TPESampler(seed=seed),
         pruner=optuna.pruners.MedianPruner(n_startup_trials=5) if len(wanted) == 1 else optuna.pruners.NopPruner())
@@ -102,6 +102,18 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
         if processes is not None:
             processes.close()
     return _result(study, name, fixed, wanted), study
+
+
+def _storage(url: str | None):
+    """The Optuna storage at `url` (None: in memory), or a ValueError naming the URL and what went wrong."""
+    import optuna
+
+    if url is None:
+        return None
+    try:
+        return optuna.storages.get_storage(url)
+    except Exception as err:  # noqa: BLE001  (SQLAlchemy's errors for a URL it cannot parse or open are many)
+        raise ValueError(f"storage {url!r}: {str(err).splitlines()[0]} (e.g. sqlite:///study.db)") from None
 
 
 def _score(record: dict, metric: str) -> float:
