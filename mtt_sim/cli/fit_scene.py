@@ -1,0 +1,45 @@
+"""`mtt-sim fit-scene`: a scene fitted to a sequence's detections alone (no labels), its detector from a sensor file;
+prints the sequence's statistics beside the scene's own and writes the scene as TOML."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+from pathlib import Path
+
+from mtt_sim.cli.arguments import FORCE_HELP, integer, output_file, replaced
+
+
+def detections_folder(text: str) -> str:
+    """A sequence folder with det/det.txt (gt/ is not needed, and not read)."""
+    folder = Path(text)
+    if not folder.is_dir() or not (folder / "det" / "det.txt").is_file():
+        raise argparse.ArgumentTypeError(f"{text!r} is not a sequence folder with det/det.txt"
+                                         + (" (no det/det.txt)" if folder.is_dir() else ""))
+    return text
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("fit-scene", help="fit a scene to a sequence's detections alone (no labels): print its "
+                                                "statistics beside the scene's and write the scene")
+    p.add_argument("folder", type=detections_folder, metavar="DIR", help="a sequence folder with det/det.txt")
+    p.add_argument("--sensor", required=True, metavar="FILE",
+                   help="the detector: a [sensor] table, e.g. from mtt-sim calibrate on other, labelled sequences")
+    p.add_argument("--out", required=True, help="the scenario to write (.toml)")
+    p.add_argument("--seeds", type=integer(1), default=2, help="scene runs averaged in the check (default 2)")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    out = output_file(args.out, args.force, "--out", (".toml",))
+    from mtt_sim.sim import scenario
+    from mtt_sim.sim2real import fit_scene
+
+    scenario.read_sensor(args.sensor)  # a bad sensor file fails before any work
+    _, real, scene, text = fit_scene.fit_scene(args.folder, args.sensor, seeds=tuple(range(args.seeds)))
+    print(fit_scene.report(real, scene, Path(args.folder).name))
+    out.write_text(text)
+    print(f"\nscene: {out}" + replaced(args.force) + f"; tune a tracker on it: mtt-sim tune SPEC --on "
+          f"{shlex.quote(str(out))}")
+    return 0

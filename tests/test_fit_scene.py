@@ -1,0 +1,122 @@
+"""mtt-sim fit-scene: a scene fitted to a sequence's detections alone, on tiny sequences whose answers are known."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from helpers import write_sequence
+from mtt_sim import cli
+from mtt_sim.env import TrackingEnv
+from mtt_sim.lab.episode import Episode
+from mtt_sim.sim import scenario
+from mtt_sim.sim2real import fit_scene
+
+W, H, FRAMES = 640, 480, 30
+A, B = 20.0, 0.5            # box height = A + B * feet row: near height 260, far/near 20/260
+NEAR = A + B * H
+NEAR_SPEED = 4.0            # px/frame at the bottom row; the image speed shrinks with the height, as the world's does
+FEET = (200.0, 260.0, 330.0, 400.0, 460.0)
+
+
+def walkers(direction=(1, 1, 1, 1, 1), late=None, heights=None):
+    """One person per feet row, in every frame, walking along x at NEAR_SPEED times its depth scale; `late`: a sixth
+    person entering at that frame."""
+    rows = []
+    people = [(y, d, 1) for y, d in zip(FEET, direction)] + ([(300.0, 1, late)] if late else [])
+    for i, (y, d, first) in enumerate(people):
+        h = heights[i] if heights is not None else A + B * y
+        vx = d * NEAR_SPEED * (A + B * y) / NEAR
+        for f in range(first, FRAMES + 1):
+            x = (100.0 if d > 0 else 500.0) + 7 * i + vx * (f - 1)
+            rows.append((f, x, y - h, 0.4 * h, h, 0.9))
+    return rows
+
+
+@pytest.fixture
+def sensor(tmp_path):
+    path = tmp_path / "sensor.toml"
+    path.write_text('[sensor]\npreset = "ideal"\nclutter_rate = 0.0\nmerge_prob = 0.0\nfragment_prob = 0.0\n')
+    return path
+
+
+def fitted(folder):
+    rows, info = fit_scene.link_sequence(folder)
+    return fit_scene.fit(rows, info), rows, info
+
+
+def test_estimates_equal_the_known_answers(tmp_path):
+    raw, rows, info = fitted(write_sequence(tmp_path / "seq", walkers(), size=(W, H)))
+    g = raw["groups"][0]
+    assert (raw["render"], raw["env"]) == ({"width": W, "height": H}, {"max_steps": FRAMES})
+    assert raw["world"]["projection"] == "standing"
+    assert raw["world"]["far_scale"] == pytest.approx(A / NEAR, abs=1e-3)  # exact boxes: the line is exact
+    assert g["size"] == pytest.approx([0.4 * NEAR, NEAR], abs=0.1)          # rounded to 0.1 px
+    assert g["count"] == 5 and g["birth_rate"] == 0.0                        # every person in every frame
+    assert g["speed"] == pytest.approx(NEAR_SPEED, abs=1e-3)                # exact boxes: the SORT boxes are them
+    assert (g["heading"], g["heading_jitter"]) == (pytest.approx(0.0, abs=0.1), 45.0)
+    assert g["region"][1] == pytest.approx(FEET[0] / H, abs=0.02) and g["region"][3] == pytest.approx(FEET[-1] / H,
+                                                                                                       abs=0.02)
+    st = fit_scene.statistics(rows, info.length, H)
+    assert st["people"] == 5.0 and st["far_near"] == pytest.approx(A / NEAR, abs=1e-3)
+
+
+def test_a_late_person_is_a_birth_and_opposite_walkers_go_any_way(tmp_path):
+    # SORT reports the late one once 3 matches have followed its first detection: 1 start after frame 1, and
+    # 5 + (20 - 3) / 30 people per frame (it is detected in frames 11..30)
+    raw, rows, info = fitted(write_sequence(tmp_path / "seq", walkers((1, -1, 1, -1, -1), late=11), size=(W, H)))
+    g = raw["groups"][0]
+    assert g["birth_rate"] == pytest.approx(1 / (FRAMES - 1), abs=1e-4)
+    assert fit_scene.statistics(rows, FRAMES, H)["people"] == pytest.approx(5 + 17 / 30)
+    assert (g["heading"], g["heading_jitter"]) == (0.0, 180.0)
+
+
+def test_heights_that_do_not_grow_downward_make_a_topdown_world(tmp_path):
+    raw, _, _ = fitted(write_sequence(tmp_path / "seq", walkers(heights=[50.0] * 5), size=(W, H)))
+    assert raw["world"] == {"projection": "topdown"} and raw["groups"][0]["size"] == [20.0, 50.0]
+
+
+def test_ground_truth_is_never_read(tmp_path, sensor):
+    plain = write_sequence(tmp_path / "plain", walkers(), size=(W, H))
+    labelled = tmp_path / "labelled"
+    shutil.copytree(plain, labelled)
+    (labelled / "gt").mkdir()
+    (labelled / "gt" / "gt.txt").write_text("not,a,ground,truth\n!!\n")
+    a, b = (fit_scene.fit_scene(f, sensor, seeds=()) for f in (plain, labelled))
+    assert a[0] == b[0] and a[1] == b[1]
+
+
+def test_the_written_scene_loads_and_runs(tmp_path, sensor):
+    raw, real, scene, text = fit_scene.fit_scene(write_sequence(tmp_path / "seq", walkers(), size=(W, H)), sensor)
+    assert set(real) == set(scene) == set(fit_scene.STAT_NAMES) and all(np.isfinite(list(scene.values())))
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    sc = scenario.load(path)
+    assert sc.sensor.pd == 1.0 and sc.groups[0].count == 5 and sc.env.max_steps == FRAMES
+    episode = Episode(TrackingEnv(path, obs_mode="detections"), seed=0, steps=20)
+    for _ in episode:
+        pass
+    assert episode.steps == 20
+
+
+def test_no_tracklets_is_an_error(tmp_path):
+    folder = write_sequence(tmp_path / "seq", [(1, 10.0, 10.0, 20.0, 50.0, 0.9)], length=10, size=(W, H))
+    with pytest.raises(scenario.ConfigError, match="no tracklets"):
+        fitted(folder)
+
+
+def test_the_command_writes_refuses_and_checks(tmp_path, sensor, capsys):
+    folder = str(write_sequence(tmp_path / "seq", walkers(), size=(W, H)))
+    out = str(tmp_path / "scene.toml")
+    assert cli.main(["fit-scene", folder, "--sensor", str(sensor), "--out", out]) == 0
+    printed = capsys.readouterr().out
+    assert "people per frame" in printed and "fitted scene" in printed and "scene.toml" in printed
+    assert scenario.load(out).groups[0].count == 5
+    assert cli.main(["fit-scene", folder, "--sensor", str(sensor), "--out", out]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert cli.main(["fit-scene", folder, "--sensor", str(sensor), "--out", out, "--force"]) == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["fit-scene", str(tmp_path), "--sensor", str(sensor), "--out", str(tmp_path / "other.toml")])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.count("\n") == 1 and "det/det.txt" in err
