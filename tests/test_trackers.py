@@ -258,6 +258,18 @@ def test_search_space_leaves_out_fixed_parameters_and_those_without_a_range():
     assert trackers.base.search_space("gnn", dict.fromkeys(every, 1)) == {}
 
 
+def test_parameters_read_only_under_a_switch_are_not_searched_when_it_is_off():
+    lmb = trackers.base.search_space("lmb")
+    assert {"reid_confidence", "reid_threshold"} <= set(lmb)  # re-identification is on by default
+    off = trackers.base.search_space(*trackers.parse_spec("lmb:reid=false"))
+    assert set(off) == set(lmb) - {"reid_confidence", "reid_threshold"}
+    assert set(trackers.base.search_space(*trackers.parse_spec("lmb:reid=true"))) == set(lmb)
+    traditional = trackers.base.search_space(*trackers.parse_spec("jpda:situations=false"))
+    assert set(trackers.base.search_space("jpda")) - set(traditional) == {"revive_frames", "merge_frames"}
+    with pytest.raises(ValueError, match="reid=.maybe."):
+        trackers.base.search_space("lmb", {"reid": "maybe"})
+
+
 GOOD = np.array([[10, 10, 5, 8, 0.9], [30, 30, 6, 6, 0.5], [0, 0, 0, 0, 0]], np.float32)
 FRAME = np.zeros((40, 60, 3), np.uint8)
 

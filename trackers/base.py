@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import difflib
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -111,6 +111,7 @@ class Param:
     allowed: str | tuple[str, ...] | None = None
     meaning: str = ""  # what it is, with its unit
     search: tuple = ()  # where a tuner looks: (lo, hi) or (lo, hi, "log") for a number, the choices otherwise; () never
+    needs: Mapping = field(default_factory=dict)  # switches it is read under, e.g. {"reid": True}: untuned otherwise
 
     def __post_init__(self):
         if isinstance(self.allowed, str) and not _INTERVAL.match(self.allowed):
@@ -256,12 +257,21 @@ def describe(name: str) -> list[str]:
     return [f"{key + '=' + repr(param.default):34s} {param.allowed_text()}" + (f"; {param.meaning}" if param.meaning
                                                                                else "")
             + (f"; tuned in {param.search_text()}" if param.search else "")
+            + "".join(f" with {k}={str(v).lower()}" for k, v in param.needs.items())
             for key, param in REGISTRY[name].parameters.items()]
 
 
 def search_space(name: str, fixed: Mapping = ()) -> dict[str, Param]:
-    """The tunable parameters of a registered tracker, less those `fixed` (given in its spec)."""
-    return {key: p for key, p in REGISTRY[name].parameters.items() if p.search and key not in fixed}
+    """The tunable parameters of a registered tracker, less those `fixed` (given in its spec) and those whose switch
+    (`needs`) is not searched and is set, by the spec or by default, to a value under which they are never read."""
+    params, given = REGISTRY[name].parameters, dict(fixed) if isinstance(fixed, Mapping) else dict.fromkeys(fixed)
+    searched = {key for key, p in params.items() if p.search and key not in given}
+
+    def value(key):
+        return params[key].check(name, key, given[key]) if given.get(key) is not None else params[key].default
+
+    return {key: p for key, p in params.items() if key in searched
+            and all(switch in searched or value(switch) == wanted for switch, wanted in p.needs.items())}
 
 
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:

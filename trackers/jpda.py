@@ -190,7 +190,8 @@ class Jpda(Tracker):
         "k": Param(0, "[0, inf)", "joint events per cluster; 0: the paper's K = targets + measurements"),
         "vanish_frames": Param(3, "[1, inf)", "frames in a row without a measurement that end a target",
                                (1, 30, "log")),
-        "revive_frames": Param(5, "[0, inf)", "frames an ended target can still be revived", (1, 60, "log")),
+        "revive_frames": Param(5, "[0, inf)", "frames an ended target can still be revived", (1, 60, "log"),
+                               needs={"situations": True}),
         "accel_sigma": Param(0.5, "[0, inf)", "white acceleration, px/frame^2 (Stone Soup ConstantVelocity(q): "
                                               "sqrt(q))", (0.05, 5.0, "log")),
         "meas_sigma": Param(4.0, "(0, inf)", "detection centre noise, px", (1.0, 50.0, "log")),
@@ -201,7 +202,7 @@ class Jpda(Tracker):
         "min_hits": Param(3, "[1, inf)", "frames in a row with a measurement before a target is reported (paper: 1)",
                           (1, 8)),
         "merge_frames": Param(40, "[1, inf)", "frames in one blob after which the younger target is a duplicate",
-                              (5, 200, "log")),
+                              (5, 200, "log"), needs={"situations": True}),
         "coast": Param(True, None, "report confirmed targets through their misses (paper: false)"),
         "early_duplicates": Param(True, None, "drop a newborn duplicate before reading the situations (paper: false)"),
         "occlusion_covariance": Param("position", ("position", "full"), "what an occluded target's covariance "

@@ -170,8 +170,9 @@ class LabelledMultiBernoulli(Tracker):
         "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
         "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
         "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool",
-                                 (0.3, 0.95)),
-        "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log")),
+                                 (0.3, 0.95), needs={"reid": True}),
+        "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log"),
+                                needs={"reid": True}),
         "pool_per_target": Param(10, "[1, inf)", "pooled features per target of the first frame"),
         "pool_every": Param(10, "[1, inf)", "frames between pool updates"),
         "reid_metric": Param("", None, "an XQDA metric file from mtt-sim learn-reid (empty: the shipped one)")}
