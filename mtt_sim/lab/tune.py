@@ -18,7 +18,7 @@ from typing import Mapping, Sequence
 from mtt_sim import trackers
 from mtt_sim.lab.experiment import episode_pool, run_tasks
 from mtt_sim.metrics.goals import Goal, goals
-from mtt_sim.sim.scenario import toml_scalar
+from mtt_sim.sim.scenario import to_toml
 from mtt_sim.trackers.base import parse_spec, search_space, spec_of
 
 @dataclass
@@ -43,10 +43,7 @@ class Result:
         """The result as TOML: the spec, the scores and the parameters."""
         head = {k: v for k, v in self.as_dict().items() if k in ("spec", "metric", "trials")}
         scores = {k: v for k, v in (("value", self.value), ("default_value", self.default_value)) if v is not None}
-        lines = [f"{k} = {toml_scalar(v)}" for k, v in head.items()]
-        lines += [f"{k} = [{', '.join(map(toml_scalar, v))}]" if isinstance(v, list) else f"{k} = {toml_scalar(v)}"
-                  for k, v in scores.items()]
-        return "\n".join(lines + ["", "[params]", *(f"{k} = {toml_scalar(v)}" for k, v in self.params.items())]) + "\n"
+        return to_toml({**head, **scores, "params": self.params})
 
 
 def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 50, seeds: Sequence[int] = (0,),

@@ -15,7 +15,7 @@ import tomllib
 import typing
 from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -366,6 +366,24 @@ def toml_scalar(value) -> str:
     if isinstance(value, str):
         return f'"{value}"'
     return str(value) if isinstance(value, int) else repr(float(value))
+
+
+def to_toml(mapping: Mapping, comments: Sequence[str] = ()) -> str:
+    """A mapping as TOML text after a comment header: its plain keys (scalars, lists of scalars), then its tables,
+    then its arrays of tables ([[groups]]); one level deep, what scenarios, sensor files and tuning results need."""
+    def table(items: Mapping) -> str:
+        return "".join(f"{k} = " + (f"[{', '.join(map(toml_scalar, v))}]" if isinstance(v, (list, tuple))
+                                    else toml_scalar(v)) + "\n" for k, v in items.items())
+
+    def tables(v) -> bool:
+        return isinstance(v, (list, tuple)) and bool(v) and all(isinstance(t, Mapping) for t in v)
+
+    text = "".join(f"# {line}\n" for line in comments)
+    plain = {k: v for k, v in mapping.items() if not isinstance(v, Mapping) and not tables(v)}
+    parts = [table(plain)] if plain else []
+    parts += [f"[{k}]\n" + table(v) for k, v in mapping.items() if isinstance(v, Mapping)]
+    parts += [f"[[{k}]]\n" + table(t) for k, v in mapping.items() if tables(v) for t in v]
+    return text + "\n".join(parts)
 
 
 def read_sensor(path: str | Path) -> dict:

@@ -459,11 +459,7 @@ def to_toml(c: Calibration) -> str:
 
 
 def sensor_toml(sensor: dict, comments: Sequence[str] = ()) -> str:
-    """A [sensor] table as TOML text (what read_sensor and the presets read), after a comment of these lines."""
-    return "".join(f"# {line}\n" for line in comments) + "[sensor]\n" + "".join(
-        f"{k} = {toml_value(v)}\n" for k, v in sensor.items())
-
-
-def toml_value(value) -> str:
-    """A scalar as TOML text, numbers as floats (what the [sensor] table's keys are)."""
-    return scn.toml_scalar(value if isinstance(value, (bool, str)) else float(value))
+    """A [sensor] table as TOML text (what read_sensor and the presets read), numbers as floats, after a comment of
+    these lines."""
+    table = {k: v if isinstance(v, (bool, str)) else float(v) for k, v in sensor.items()}
+    return scn.to_toml({"sensor": table}, comments)

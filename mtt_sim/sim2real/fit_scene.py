@@ -196,24 +196,6 @@ def report(real: dict, scene: dict, name: str) -> str:
     return "\n".join(lines)
 
 
-def to_toml(raw: dict, comments=()) -> str:
-    """A scenario mapping as TOML text (top-level keys, then tables, then [[groups]]), after a comment header."""
-    def value(v):
-        return "[" + ", ".join(map(scn.toml_scalar, v)) + "]" if isinstance(v, (list, tuple)) else scn.toml_scalar(v)
-
-    def body(d):
-        return "".join(f"{k} = {value(v)}\n" for k, v in d.items())
-
-    text = "".join(f"# {line}\n" for line in comments)
-    text += body({k: v for k, v in raw.items() if not isinstance(v, (dict, list))})
-    for k, v in raw.items():
-        if isinstance(v, dict):
-            text += f"\n[{k}]\n" + body(v)
-    for g in raw.get("groups", []):
-        text += "\n[[groups]]\n" + body(g)
-    return text
-
-
 def fit_scene(folder, sensor=None, seeds=(0, 1)) -> tuple[dict, dict, dict, str]:
     """Fit a scene to a sequence folder's detections: (the scene as a mapping with the sensor merged in, the
     sequence's statistics, the scene's statistics over `seeds`, the TOML text with its header)."""
@@ -227,4 +209,4 @@ def fit_scene(folder, sensor=None, seeds=(0, 1)) -> tuple[dict, dict, dict, str]
               f"{MIN_FRAMES} frames linked by {LINKER}).",
               "Detector: " + (f"the [sensor] table of {Path(sensor).name}." if sensor is not None else "the default."),
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]
-    return raw, real, scene, to_toml(raw, header)
+    return raw, real, scene, scn.to_toml(raw, header)
