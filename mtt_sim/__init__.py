@@ -24,6 +24,8 @@ for _key, _id in env_ids().items():
         register(id=_id, entry_point="mtt_sim.env:TrackingEnv", kwargs={"scenario": _key})
 if "mtt_sim/Replay-v0" not in registry:  # a recorded sequence: gym.make("mtt_sim/Replay-v0", sequence="path/to/folder")
     register(id="mtt_sim/Replay-v0", entry_point="mtt_sim.env:TrackingEnv", kwargs={"scenario": None})
+if "mtt_sim/TrackManagement-v0" not in registry:  # the agent decides which of SORT's candidates to report and keep
+    register(id="mtt_sim/TrackManagement-v0", entry_point="mtt_sim.learn.management_env:TrackManagementEnv")
 
 
 def __getattr__(name: str):

@@ -19,10 +19,10 @@ import statistics
 from pathlib import Path
 
 import optuna
+from mtt_sim.trackers.base import parse_spec, search_space, spec_of
 
 from mtt_sim import trackers
 from mtt_sim.lab.experiment import run_episode
-from mtt_sim.trackers.base import parse_spec, search_space, spec_of
 
 METRICS = ("MOTA", "IDF1", "HOTA")
 

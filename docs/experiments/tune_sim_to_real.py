@@ -6,6 +6,8 @@ several processes can share one file, each with its own --trackers); then a Mark
 share of the oracle's gain each route recovers, and which tracker each route would pick.
 
     python docs/experiments/tune_sim_to_real.py ../shared/data/mot15 OUT.jsonl --trackers sort,bytetrack --trials 30
+    python docs/experiments/tune_sim_to_real.py ../shared/data/mot15 OUT.jsonl --trackers jpda --trials 20 \
+        --seeds 4 --frames 400
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import statistics
 import tomllib
 from pathlib import Path
 
+from mtt_sim.env import TrackingEnv
 from mtt_sim.lab.experiment import run_episode
 from mtt_sim.lab.tune import tune
 from mtt_sim.sim2real.calibrate import calibrate, to_toml
@@ -33,7 +36,9 @@ def main() -> None:
     p.add_argument("--routes", default=",".join(ROUTES))
     p.add_argument("--metric", default="HOTA")
     p.add_argument("--trials", type=int, default=30)
-    p.add_argument("--seeds", type=int, default=2, help="episodes per trial on a simulated source")
+    p.add_argument("--seeds", type=int, default=2, help="at most this many episodes per trial on a simulated source")
+    p.add_argument("--frames", type=int, default=0,
+                   help="fewer seeds for long sequences: about this many frames a trial (0: always --seeds)")
     p.add_argument("--table", action="store_true", help="only print the table of the rows in OUT")
     args = p.parse_args()
     out = Path(args.out)
@@ -47,7 +52,6 @@ def measure(args, out: Path) -> None:
     work = out.with_suffix("")
     work.mkdir(parents=True, exist_ok=True)
     done = {(r["sequence"], r["tracker"], r["route"]) for r in map(json.loads, _lines(out))}
-    seeds = range(args.seeds)
     generic = {}
     for folder in folders:
         sensor = work / f"fitted_without_{folder.name}.toml"
@@ -58,24 +62,35 @@ def measure(args, out: Path) -> None:
             scene.write_text(fit_scene(folder, sensor, seeds=())[3])
         twin = {"sensor.model": "synthetic",
                 **{f"sensor.{k}": v for k, v in tomllib.loads(sensor.read_text())["sensor"].items()}}
+        seeds = _seeds(args, TrackingEnv(str(folder)).source.length)
         for spec in args.trackers.split(","):
             defaults = None
             for route in args.routes.split(","):
                 if (folder.name, spec, route) in done:
                     continue
                 if route == "generic" and spec not in generic:
-                    generic[spec] = tune(spec, [GENERIC], args.metric, args.trials, seeds=seeds)[0]
-                result = {"oracle": lambda: tune(spec, [str(folder)], args.metric, args.trials)[0],
-                          "twin": lambda: tune(spec, [str(folder)], args.metric, args.trials, seeds, twin)[0],
-                          "scene": lambda: tune(spec, [str(scene)], args.metric, args.trials, seeds)[0],
-                          "generic": lambda: generic[spec]}[route]()
+                    generic[spec] = tune(spec, [GENERIC], args.metric, args.trials,
+                                         _seeds(args, TrackingEnv(GENERIC).source.config.env.max_steps))[0]
+                if route == "oracle":
+                    result = tune(spec, [str(folder)], args.metric, args.trials)[0]
+                elif route == "twin":
+                    result = tune(spec, [str(folder)], args.metric, args.trials, seeds, twin)[0]
+                elif route == "scene":
+                    result = tune(spec, [str(scene)], args.metric, args.trials, seeds)[0]
+                else:
+                    result = generic[spec]
                 defaults = defaults if defaults is not None else _real(folder, spec, args.metric)
                 row = {"sequence": folder.name, "tracker": spec, "route": route, "defaults": defaults,
                        "tuned_value": result.value, "real": _real(folder, result.spec, args.metric),
-                       "spec": result.spec, "trials": args.trials}
+                       "spec": result.spec, "trials": args.trials, "seeds": len(seeds)}
                 with out.open("a") as f:
                     f.write(json.dumps(row) + "\n")
                 print(json.dumps(row), flush=True)
+
+
+def _seeds(args, length: int) -> range:
+    """--seeds, or with --frames as many as make about that many frames (1 to --seeds)."""
+    return range(max(1, min(args.seeds, round(args.frames / length))) if args.frames else args.seeds)
 
 
 def _lines(path: Path) -> list[str]:

@@ -18,13 +18,14 @@ from mtt_sim.real.sequence import read_rows
 
 
 def export_episode(scenario: str, out: str | Path, seed: int = 0, steps: int | None = None,
-           config: Mapping | None = None, progress: bool = False) -> dict:
-    """Run `scenario` without a tracker and write its frames, ground truth and detections as a sequence. Frames an
-    earlier, longer export left in `out` are removed. A recorded sequence (with `sensor.model = "synthetic"`: its
-    twin) keeps its own gt.txt, and frames only where it has images."""
+           config: Mapping | None = None, progress: bool = False, frames: bool = True) -> dict:
+    """Run `scenario` without a tracker and write its frames (unless `frames` is False), ground truth and detections
+    as a sequence. Frames an earlier, longer export left in `out` are removed. A recorded sequence (with
+    `sensor.model = "synthetic"`: its twin) keeps its own gt.txt, and frames only where it has images."""
     out = Path(out)
     recorded = is_sequence(scenario)
-    env = TrackingEnv(scenario, config=config, obs_mode=None if recorded else "frame+detections")
+    env = TrackingEnv(scenario, config=config, obs_mode=None if recorded
+                     else "frame+detections" if frames else "detections")
     (out / "gt").mkdir(parents=True, exist_ok=True)
     (out / "det").mkdir(exist_ok=True)
     for old in (out / "img1").glob("[0-9]*.jpg"):

@@ -1,0 +1,1 @@
+"""Learning from the environment: track management as a decision process, and a policy search over it."""
