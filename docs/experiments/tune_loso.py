@@ -101,7 +101,12 @@ def table(rows: list[dict], metric: str) -> str:
         cells = [f"{100 * _mean(defaults, sequences, m):.1f} | {100 * statistics.fmean(held_out[m]):.1f}"
                  for m in METRICS]
         lines.append(f"| {spec} | {len(pool) - 1} | " + " | ".join(cells) + " |")
-        picks_text += [f"- {spec}", *(f"  - {p}" for p in picked)]
+        distinct = {}
+        for p in picked:
+            sequence, chosen = p.split(": ", 1)
+            distinct.setdefault(chosen, []).append(sequence)
+        picks_text += [f"- {spec}: {len(distinct)} distinct picks over {len(sequences)} folds",
+                       *(f"  - held out {', '.join(s)}: `{c}`" for c, s in distinct.items())]
     return "\n".join(lines + ["", f"Picked by mean {metric} on the other sequences:", *picks_text])
 
 
