@@ -165,3 +165,27 @@ def test_a_hand_initialised_tracker_starts_from_the_scored_first_frame(tmp_path)
     _, info = TrackingEnv(folder).reset(seed=0)
     assert info["init_ids"].tolist() == [1] and info["init_boxes"].tolist() == [list(A)]
     assert trackers.make("ipf").reset(info) is None
+
+
+def test_a_binary_ground_truth_file_is_named_with_what_was_expected(tmp_path):
+    folder = write_sequence(tmp_path / "seq", det=[(1, 10.0, 10.0, 5.0, 10.0, 0.9)], gt=[])
+    (folder / "gt" / "gt.txt").write_bytes(b"\xeb\x00\xff binary")
+    with pytest.raises(ValueError, match=r"gt\.txt: not a text file \('utf-8' codec can't decode byte 0xeb.*expected "
+                                         r"comma-separated MOTChallenge rows"):
+        Recording(folder)
+
+
+def test_a_detection_with_a_negative_width_names_the_file_row_and_frame(tmp_path):
+    folder = write_sequence(tmp_path / "seq", det=[(1, 10.0, 10.0, 5.0, 10.0, 0.9), (2, 10.0, 10.0, -5.0, 10.0, 0.9)])
+    with pytest.raises(ValueError, match=r"det\.txt: row 2 \(frame 2\) has width -5 and height 10: both must be "
+                                         "positive"):
+        Recording(folder)
+
+
+def test_an_id_twice_in_one_ground_truth_frame_names_the_file_frame_and_id(tmp_path):
+    gt = [(1, 7, 10.0, 10.0, 5.0, 10.0, 1, 1, 1.0), (2, 7, 10.0, 10.0, 5.0, 10.0, 1, 1, 1.0),
+          (2, 7, 30.0, 10.0, 5.0, 10.0, 1, 1, 1.0)]
+    folder = write_sequence(tmp_path / "seq", det=[(1, 10.0, 10.0, 5.0, 10.0, 0.9)], gt=gt)
+    with pytest.raises(ValueError, match=r"gt\.txt: frame 2 has id 7 in rows 2 and 3: a ground-truth id appears at "
+                                         "most once a frame"):
+        Recording(folder)

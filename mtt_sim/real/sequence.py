@@ -81,6 +81,8 @@ class Recording:
         self.info = _read_info(self.folder, [det, gt if gt is not None else np.zeros((0, 7))])
         for path, rows in ((det_file, det), (gt_file, gt)):
             check_frames(path, rows, self.info.length)
+        check_sizes(det_file, det)
+        check_unique_ids(gt_file, gt)
         self.scored = gt is not None
         self.benchmark = benchmark or _benchmark_of(self.info.name, gt)
         if self.benchmark not in BENCHMARKS:
@@ -259,7 +261,11 @@ def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path}: not found")
-    text = path.read_text().strip()
+    try:
+        text = path.read_text().strip()
+    except UnicodeDecodeError as err:
+        raise ValueError(f"{path}: not a text file ({err}); expected comma-separated MOTChallenge rows (frame, id, x, "
+                         "y, w, h, ...)") from None
     if not text:
         return np.zeros((0, min_columns))
     try:
@@ -283,6 +289,28 @@ def check_frames(path: Path, rows: np.ndarray | None, length: int) -> None:
     if bad.any():
         raise ValueError(f"{path}: row {int(np.flatnonzero(bad)[0]) + 1} has frame {frames[bad][0]:g}, outside the "
                          f"sequence's 1..{length} (seqLength)")
+
+
+def check_sizes(path: Path, rows: np.ndarray) -> None:
+    """Every box must have a positive width and height."""
+    bad = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{path}: row {k + 1} (frame {rows[k, 0]:g}) has width {rows[k, 4]:g} and height "
+                         f"{rows[k, 5]:g}: both must be positive (columns: frame, id, x, y, w, h, ...)")
+
+
+def check_unique_ids(path: Path, rows: np.ndarray | None) -> None:
+    """A ground-truth id appears at most once a frame."""
+    if rows is None or not len(rows):
+        return
+    pairs = rows[:, :2]
+    _, first, counts = np.unique(pairs, axis=0, return_index=True, return_counts=True)
+    if (counts > 1).any():
+        repeated = pairs[first[counts > 1][0]]
+        where = np.flatnonzero((pairs == repeated).all(axis=1)) + 1
+        raise ValueError(f"{path}: frame {repeated[0]:g} has id {repeated[1]:g} in rows {where[0]} and {where[1]}: a "
+                         "ground-truth id appears at most once a frame")
 
 
 def by_frame(rows: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
