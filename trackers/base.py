@@ -13,6 +13,8 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from . import plugins
+
 
 @dataclass(frozen=True)
 class Tracks:
@@ -240,31 +242,49 @@ class Tracker:
 REGISTRY: dict[str, Callable[..., Tracker]] = {}
 
 
-def register(cls):
-    """Class decorator adding a tracker to the registry under its `name`."""
-    REGISTRY[cls.name] = cls
+def register(cls, name: str | None = None):
+    """Class decorator adding a tracker to the registry under its `name` (or `name`)."""
+    REGISTRY[name or cls.name] = cls
     return cls
 
 
 def available() -> dict[str, str]:
-    """Registered tracker names with their one-line descriptions."""
+    """Registered tracker names, installed plugins' included, with their one-line descriptions."""
+    plugins.load_plugins(register)
     return {name: cls.description for name, cls in sorted(REGISTRY.items())}
 
 
+def tracker_class(name: str) -> type:
+    """The class of a registered tracker (any letter case, installed plugins included) or of one named by location
+    ('mypkg.mine:MyTracker', './mine.py:MyTracker'); a ValueError naming what is available otherwise."""
+    if plugins.is_location(name):
+        location, _, class_name = name.rpartition(":")
+        if not location or not class_name:
+            raise ValueError(f"tracker {name!r}: expected module:Class or path/to/file.py:Class")
+        return plugins.load_class(location, class_name, Tracker)
+    plugins.load_plugins(register)
+    cls = REGISTRY.get(name.lower())
+    if cls is None:
+        near = difflib.get_close_matches(name.lower(), REGISTRY, n=1)
+        raise ValueError(f"unknown tracker {name!r}" + (f" (did you mean {near[0]!r}?)" if near else "")
+                         + f"; available: {', '.join(sorted(REGISTRY))}, or module:Class, or file.py:Class")
+    return cls
+
+
 def describe(name: str) -> list[str]:
-    """A registered tracker's parameters, a line each: name=default, the allowed values, what it means and, for a
-    tunable one, where a tuner looks."""
+    """A tracker's parameters, a line each: name=default, the allowed values, what it means and, for a tunable one,
+    where a tuner looks."""
     return [f"{key + '=' + repr(param.default):34s} {param.allowed_text()}" + (f"; {param.meaning}" if param.meaning
                                                                                else "")
             + (f"; tuned in {param.search_text()}" if param.search else "")
             + "".join(f" with {k}={str(v).lower()}" for k, v in param.needs.items())
-            for key, param in REGISTRY[name].parameters.items()]
+            for key, param in tracker_class(name).parameters.items()]
 
 
 def search_space(name: str, fixed: Mapping = ()) -> dict[str, Param]:
-    """The tunable parameters of a registered tracker, less those `fixed` (given in its spec) and those whose switch
-    (`needs`) is not searched and is set, by the spec or by default, to a value under which they are never read."""
-    params, given = REGISTRY[name].parameters, dict(fixed) if isinstance(fixed, Mapping) else dict.fromkeys(fixed)
+    """The tunable parameters of a tracker, less those `fixed` (given in its spec) and those whose switch (`needs`) is
+    not searched and is set, by the spec or by default, to a value under which they are never read."""
+    params, given = tracker_class(name).parameters, dict(fixed) if isinstance(fixed, Mapping) else dict.fromkeys(fixed)
     searched = {key for key, p in params.items() if p.search and key not in given}
 
     def value(key):
@@ -275,8 +295,12 @@ def search_space(name: str, fixed: Mapping = ()) -> dict[str, Param]:
 
 
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
-    """'sort:max_age=3,min_hits=1' -> ('sort', {'max_age': '3', 'min_hits': '1'})."""
+    """'sort:max_age=3,min_hits=1' -> ('sort', {'max_age': '3', 'min_hits': '1'}); a tracker named by location keeps
+    its class: './mine.py:Mine:gain=2' -> ('./mine.py:Mine', {'gain': '2'})."""
     name, _, rest = str(spec).partition(":")
+    if plugins.is_location(name.strip()):
+        class_name, _, rest = rest.partition(":")
+        name = f"{name.strip()}:{class_name.strip()}"
     params: dict[str, str] = {}
     for item in filter(None, (i.strip() for i in rest.split(","))):
         key, sep, value = item.partition("=")
@@ -312,12 +336,7 @@ def split_specs(text: str) -> list[str]:
 
 
 def make(spec: str, **params) -> Tracker:
-    """A tracker by name (in any letter case) or spec ('sort', 'sort:max_age=3'); keyword parameters override the
-    spec's."""
+    """A tracker by name (in any letter case) or spec ('sort', 'sort:max_age=3', 'mypkg.mine:Mine:gain=2',
+    './mine.py:Mine'); keyword parameters override the spec's."""
     name, spec_params = parse_spec(spec)
-    cls = REGISTRY.get(name.lower())
-    if cls is None:
-        near = difflib.get_close_matches(name.lower(), REGISTRY, n=1)
-        raise ValueError(f"unknown tracker {name!r}" + (f" (did you mean {near[0]!r}?)" if near else "")
-                         + f"; available: {', '.join(sorted(REGISTRY))}")
-    return cls(**{**spec_params, **params})
+    return tracker_class(name)(**{**spec_params, **params})

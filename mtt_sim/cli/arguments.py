@@ -113,10 +113,13 @@ def tracker_specs(text: str) -> list[str]:
     canonical = []
     for spec in specs:
         try:
-            name = trackers.make(spec).name
+            tracker = trackers.make(spec)
         except ValueError as err:
             raise argparse.ArgumentTypeError(str(err)) from None
-        canonical.append(name + spec[len(spec.partition(":")[0]):])  # the name as registered, the parameters as typed
+        name = trackers.parse_spec(spec)[0]
+        if not trackers.base.plugins.is_location(name):  # a registered one by its name as registered
+            spec = tracker.name + spec[len(spec.partition(":")[0]):]
+        canonical.append(spec)
     return canonical
 
 

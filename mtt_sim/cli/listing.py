@@ -8,8 +8,11 @@ from mtt_sim.sim import scenario
 def add(subparsers) -> None:
     subparsers.add_parser("list", help="scenarios with their env ids and one-line descriptions").set_defaults(
         func=run_list)
-    subparsers.add_parser("trackers", help="trackers with their descriptions and parameters (default, allowed values)"
-                          ).set_defaults(func=run_trackers)
+    p = subparsers.add_parser("trackers", help="trackers with their descriptions and parameters (default, allowed "
+                                               "values); installed plugins included")
+    p.add_argument("names", nargs="*", metavar="TRACKER",
+                   help="only these: registered names, or your own as module:Class or path/to/file.py:Class")
+    p.set_defaults(func=run_trackers)
 
 
 def run_list(args) -> int:
@@ -26,7 +29,8 @@ def run_list(args) -> int:
 def run_trackers(args) -> int:
     from mtt_sim import trackers
 
-    for name, cls in sorted(trackers.base.REGISTRY.items()):
+    for name in args.names or trackers.base.available():
+        cls = trackers.base.tracker_class(name)
         print(f"{name}: {cls.description}")
         for line in trackers.base.describe(name):
             print("    " + line)

@@ -57,7 +57,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
 
     name, fixed = parse_spec(spec)
     tracker = trackers.make(spec)  # a bad spec fails here, before any episode
-    space = search_space(tracker.name, fixed)
+    space = search_space(name, fixed)
     if not space:
         raise ValueError(f"tracker {tracker.name!r} has no tunable parameter left to search (fixed in the spec: "
                          f"{', '.join(fixed) or 'none'})")
