@@ -30,44 +30,88 @@ class Sort(Tracker):
         "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.95))}
 
     def reset(self, info=None):
+        self.tracks = SortTracks(self.params["iou_threshold"])
+
+    def update(self, obs) -> Tracks:
+        p, tracks = self.params, self.tracks
+        dets = detections(obs)
+        tracks.advance(dets[dets[:, 4] >= p["min_confidence"]])
+        streak, misses = tracks.counts[:, 0], tracks.counts[:, 3]
+        report = (misses < 1) & ((streak >= p["min_hits"]) | (tracks.frame <= p["min_hits"]))
+        return Tracks.of(*tracks.decide(report, misses <= p["max_age"]))
+
+
+class SortTracks:
+    """SORT's tracks without its two decisions: `advance(dets)` predicts, associates and starts tracks from a frame's
+    detections as the reference does, keeping per track its streak, hits, age and misses and its last matched
+    detection's confidence and IoU with the prediction; `decide(report, keep)` returns the reported tracks and drops
+    those not kept. SORT decides by min_hits and max_age; `management.Candidates` hands the decisions to a policy.
+    With a `capacity`, the tracks missed longest are dropped first beyond it."""
+
+    def __init__(self, iou_threshold: float = 0.3, capacity: int | None = None):
+        self.iou_threshold, self.capacity = iou_threshold, capacity
         self.kf = KalmanBank(box_model())
         self.ids = np.zeros(0, np.int64)
-        self.streak = np.zeros(0, np.int64)      # matches in a row since the track's first detection
-        self.since_update = np.zeros(0, np.int64)  # frames since the last match
+        self.counts = np.zeros((0, 4), np.int64)   # streak, hits, age, misses
+        self.last = np.zeros((0, 2))                # confidence, match IoU of the last matched detection
         self.next_id, self.frame = 1, 0
+
+    def __len__(self) -> int:
+        return len(self.ids)
 
     def _keep(self, mask: np.ndarray) -> None:
         self.kf.keep(mask)
-        self.ids, self.streak, self.since_update = self.ids[mask], self.streak[mask], self.since_update[mask]
+        self.ids, self.counts, self.last = self.ids[mask], self.counts[mask], self.last[mask]
 
-    def update(self, obs) -> Tracks:
-        p = self.params
-        dets = detections(obs)
-        corners = dets[dets[:, 4] >= p["min_confidence"], :4].copy()
+    def advance(self, dets: np.ndarray) -> None:
+        """Move the tracks on one frame with its detections (x, y, w, h, confidence), as SORT does."""
+        corners = dets[:, :4].copy()
         corners[:, 2:] += corners[:, :2]
         self.frame += 1
         stop_shrinking_to_nothing(self.kf)
         self.kf.predict()
-        self.streak[self.since_update > 0] = 0
-        self.since_update += 1
+        self.counts[self.counts[:, 3] > 0, 0] = 0   # a streak ends with a miss
+        self.counts[:, 2:] += 1                     # age, misses
         predicted = state_to_corners(self.kf.x)
         defined = ~np.isnan(predicted).any(axis=1)
         self._keep(defined)
-        matched, new = associate(corners, predicted[defined], p["iou_threshold"])
-        self.kf.update(matched[:, 1], corners_to_measurement(corners[matched[:, 0]]))
-        self.streak[matched[:, 1]] += 1
-        self.since_update[matched[:, 1]] = 0
+        predicted = predicted[defined]
+        matched, new = associate(corners, predicted, self.iou_threshold)
+        d, t = matched[:, 0], matched[:, 1]
+        self.kf.update(t, corners_to_measurement(corners[d]))
+        self.counts[t, 0] += 1
+        self.counts[t, 1] += 1
+        self.counts[t, 3] = 0
+        self.last[t, 0], self.last[t, 1] = dets[d, 4], paired_iou(corners[d], predicted[t])
         self.kf.add(corners_to_measurement(corners[new]))
-        self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + len(new))]
-        self.streak, self.since_update = np.r_[self.streak, np.zeros(len(new), np.int64)], np.r_[
-            self.since_update, np.zeros(len(new), np.int64)]
+        self.ids = np.concatenate([self.ids, np.arange(self.next_id, self.next_id + len(new))])
+        self.counts = np.concatenate([self.counts, np.zeros((len(new), 4), np.int64)])
+        self.last = np.concatenate([self.last, np.stack([dets[new, 4], np.ones(len(new))], axis=1)])
         self.next_id += len(new)
-        report = (self.since_update < 1) & ((self.streak >= p["min_hits"]) | (self.frame <= p["min_hits"]))
-        box = state_to_corners(self.kf.x[report])
+        if self.capacity is not None and len(self) > self.capacity:
+            order = np.argsort(self.counts[:, 3], kind="stable")
+            self._keep(np.isin(np.arange(len(self)), order[:self.capacity]))
+
+    def boxes(self) -> np.ndarray:
+        """Every candidate's box (x, y, w, h) from its filter's state."""
+        box = state_to_corners(self.kf.x)
         box[:, 2:] -= box[:, :2]
-        out = Tracks.of(self.ids[report], box)
-        self._keep(self.since_update <= p["max_age"])
+        return box
+
+    def decide(self, report: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The reported candidates' (ids, boxes), then drop those not kept."""
+        report, keep = np.asarray(report, bool), np.asarray(keep, bool)
+        out = self.ids[report], self.boxes()[report]
+        self._keep(keep)
         return out
+
+
+def paired_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """IoU of corner boxes a[i] and b[i], row by row."""
+    wh = np.clip(np.minimum(a[:, 2:], b[:, 2:]) - np.maximum(a[:, :2], b[:, :2]), 0, None)
+    inter = wh[:, 0] * wh[:, 1]
+    area = lambda c: (c[:, 2] - c[:, 0]) * (c[:, 3] - c[:, 1])
+    return inter / (area(a) + area(b) - inter)
 
 
 def associate(dets: np.ndarray, tracks: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
