@@ -34,6 +34,7 @@ def main() -> None:
     p.add_argument("out", help="the rows, one JSON object a line")
     p.add_argument("--trackers", default="sort,bytetrack")
     p.add_argument("--routes", default=",".join(ROUTES))
+    p.add_argument("--sequences", default="", help="only these sequences (comma-separated names; default all)")
     p.add_argument("--metric", default="HOTA")
     p.add_argument("--trials", type=int, default=30)
     p.add_argument("--seeds", type=int, default=2, help="at most this many episodes per trial on a simulated source")
@@ -49,11 +50,12 @@ def main() -> None:
 
 def measure(args, out: Path) -> None:
     folders = sorted(f for f in Path(args.data).iterdir() if (f / "gt" / "gt.txt").is_file())
+    chosen = set(args.sequences.split(",")) if args.sequences else {f.name for f in folders}
     work = out.with_suffix("")
     work.mkdir(parents=True, exist_ok=True)
     done = {(r["sequence"], r["tracker"], r["route"]) for r in map(json.loads, _lines(out))}
     generic = {}
-    for folder in folders:
+    for folder in (f for f in folders if f.name in chosen):
         sensor = work / f"fitted_without_{folder.name}.toml"
         if not sensor.is_file():
             sensor.write_text(to_toml(calibrate([f for f in folders if f != folder], seeds=1)))

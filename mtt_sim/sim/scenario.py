@@ -209,7 +209,7 @@ def scenario_dir():
     try:
         return resources.files("mtt_sim.scenarios")
     except ModuleNotFoundError:
-        return Path(__file__).resolve().parent.parent / "scenarios"
+        return Path(__file__).resolve().parents[2] / "scenarios"
 
 
 def available() -> dict[str, str]:
