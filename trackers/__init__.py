@@ -7,7 +7,7 @@ numpy/scipy/OpenCV, never importing the simulator (only `mtt_sim.trackers.*`) or
     t.reset(info); tracks = t.update(obs); env.step(tracks.to_action(env.action_space))
 """
 
-from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, learned, lmb, particle, sort  # noqa: F401  (each registers its tracker)
+from . import bytetrack, echo, gmphd, gnn, iou, ipf, jpda, learned, lmb, ocsort, particle, sort  # noqa: F401  (each registers its tracker)
 from .base import Param, Tracker, Tracks, available, make, parse_spec, register, split_specs
 from .external import External
 from .roboflow import SupervisionTracker

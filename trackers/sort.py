@@ -76,7 +76,7 @@ class SortTracks:
         defined = ~np.isnan(predicted).any(axis=1)
         self._keep(defined)
         predicted = predicted[defined]
-        matched, new = associate(corners, predicted, self.iou_threshold)
+        matched, new, _ = associate(corners, predicted, self.iou_threshold)
         d, t = matched[:, 0], matched[:, 1]
         self.kf.update(t, corners_to_measurement(corners[d]))
         self.counts[t, 0] += 1
@@ -114,23 +114,28 @@ def paired_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return inter / (area(a) + area(b) - inter)
 
 
-def associate(dets: np.ndarray, tracks: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+def associate(dets: np.ndarray, tracks: np.ndarray, threshold: float,
+              bonus: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The reference's association of detection and track corners: (matches (k, 2) of detection and track rows,
-    unmatched detections in the order the reference starts tracks from them)."""
+    unmatched detections in the order the reference starts tracks from them, unmatched tracks likewise). Where the
+    pairs above the threshold are not all alone, the assignment maximises IoU plus `bonus` (OC-SORT's direction term;
+    none for SORT); a pair under the threshold is undone either way."""
     if not len(tracks):
-        return np.zeros((0, 2), np.intp), np.arange(len(dets))
+        return np.zeros((0, 2), np.intp), np.arange(len(dets)), np.zeros(0, np.intp)
     iou = corner_iou(dets, tracks)
     if min(iou.shape) > 0:
         above = iou > threshold
         if above.sum(1).max() == 1 and above.sum(0).max() == 1:  # each pair above the threshold is alone
             matched = np.stack(np.nonzero(above), axis=1)
         else:
-            matched = lapjv(-iou)[0]
+            matched = lapjv(-iou if bonus is None else -(iou + bonus))[0]
     else:
         matched = np.zeros((0, 2), np.intp)
     low = iou[matched[:, 0], matched[:, 1]] < threshold
-    unmatched = np.setdiff1d(np.arange(len(dets)), matched[:, 0])  # never paired, then paired but under threshold
-    return matched[~low], np.r_[unmatched, matched[low, 0]].astype(np.intp)
+    # never paired, then paired but under the threshold
+    left_dets = np.concatenate([np.setdiff1d(np.arange(len(dets)), matched[:, 0]), matched[low, 0]])
+    left_tracks = np.concatenate([np.setdiff1d(np.arange(len(tracks)), matched[:, 1]), matched[low, 1]])
+    return matched[~low], left_dets.astype(np.intp), left_tracks.astype(np.intp)
 
 
 def corners_to_measurement(corners: np.ndarray) -> np.ndarray:
