@@ -1,6 +1,6 @@
 """`mtt-sim check-real DATA`: the project held against real data (the shared folder's layout, see its README).
 
-1. Baselines as published: `sort` and `bytetrack` run through the env on each `DATA/mot15/<SEQ>` and must give,
+1. Baselines as published: `sort`, `bytetrack` and `ocsort` run through the env on each `DATA/mot15/<SEQ>` and must give,
    box for box and id for id, what the reference code gave (`DATA/reference/<tracker>/<SEQ>.txt`, written with 6
    decimals, so boxes agree to half a unit of the sixth: 5e-7).
 2. Scoring as TrackEval: the env's metrics of those runs must be the published figures (the SORT README's table,
@@ -30,6 +30,10 @@ SORT = {"TUD-Campus": (62.7, 15, 113, 6), "ETH-Sunnyday": (59.1, 319, 418, 22), 
 BYTETRACK = {"TUD-Campus": (59.6, 67.9), "ETH-Sunnyday": (57.9, 74.5), "KITTI-17": (57.1, 67.2),
              "ADL-Rundle-6": (36.7, 43.3), "KITTI-13": (4.3, 41.0), "PETS09-S2L1": (63.2, 44.9),
              "TUD-Stadtmitte": (69.9, 71.0), "ETH-Bahnhof": (37.1, 54.3)}
+# MOTA, IDF1, HOTA (%) of OC-SORT's reference outputs under TrackEval (DATA/README.md)
+OCSORT = {"ADL-Rundle-6": (36.8, 44.1, 32.0), "ETH-Bahnhof": (42.2, 56.0, 41.0), "ETH-Sunnyday": (56.7, 73.2, 52.9),
+          "KITTI-13": (17.5, 41.0, 26.2), "KITTI-17": (58.3, 75.0, 46.4), "PETS09-S2L1": (57.0, 46.7, 35.2),
+          "TUD-Campus": (58.8, 69.2, 49.9), "TUD-Stadtmitte": (69.6, 73.9, 51.6)}
 # TrackEval (MotChallenge2DBox, MOT17) on Lif_T's published results (DATA/README.md)
 MOT17 = {"MOT17-02-DPM": {"MOTA": 0.404661, "IDF1": 0.502828, "HOTA": 0.449662, "TP": 7564, "FP": 19, "FN": 11017,
                           "IDSW": 26},
@@ -59,7 +63,7 @@ def check(data: str | Path, out=print) -> bool:
         out(f"{'ok  ' if ok else 'FAIL'} {text}")
 
     with tempfile.TemporaryDirectory() as tmp:
-        for tracker in ("sort", "bytetrack"):
+        for tracker in ("sort", "bytetrack", "ocsort"):
             for folder in sorted(p for p in (data / "mot15").iterdir() if p.is_dir()):
                 seq, results = folder.name, Path(tmp) / f"{tracker}-{folder.name}.txt"
                 record = run_episode(str(folder), tracker, results=str(results))
@@ -74,6 +78,9 @@ def check(data: str | Path, out=print) -> bool:
                 if tracker == "bytetrack" and seq in BYTETRACK:
                     got = (round(100 * m["MOTA"], 1), round(100 * m["IDF1"], 1))
                     report(got == BYTETRACK[seq], f"bytetrack {seq}: MOTA, IDF1 {got}, TrackEval {BYTETRACK[seq]}")
+                if tracker == "ocsort" and seq in OCSORT:
+                    got = tuple(round(100 * m[k], 1) for k in ("MOTA", "IDF1", "HOTA"))
+                    report(got == OCSORT[seq], f"ocsort {seq}: MOTA, IDF1, HOTA {got}, TrackEval {OCSORT[seq]}")
     for seq, expected in MOT17.items():
         m = evaluate_results(data / "mot17" / seq, data / "mot17_results" / "LifT" / f"{seq}.txt")
         got = {k: round(m[k], 6) if isinstance(v, float) else m[k] for k, v in expected.items()}
