@@ -15,7 +15,7 @@ import pytest
 from mtt_sim import trackers
 from mtt_sim import cli
 from mtt_sim.cli import arguments
-from mtt_sim.lab import experiment
+from mtt_sim.lab import docsite, experiment
 from mtt_sim.lab import perf
 from mtt_sim.sim import scenario
 
@@ -359,6 +359,6 @@ def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
         assert key in page and (site / "scenarios" / f"{key}.jpg").stat().st_size > 5000
         assert (site / "scenarios" / f"{key}.gif").read_bytes()[:4] == b"GIF8"
     for name in trackers.available():
-        assert "Parameters" in (site / "trackers" / name / "index.html").read_text()
+        assert "Parameters" in (site / "trackers" / docsite.page_name(name) / "index.html").read_text()
     assert "sensor.clutter_rate" in (site / "config" / "index.html").read_text()
     assert cli.main(["docs", "--out", str(site)]) == 2  # there already

@@ -9,6 +9,11 @@ from scipy.optimize import linear_sum_assignment
 from scipy.special import chdtri
 
 
+def corners(tlwh: np.ndarray) -> np.ndarray:
+    """Boxes x, y, w, h -> x1, y1, x2, y2."""
+    return np.concatenate([tlwh[:, :2], tlwh[:, :2] + tlwh[:, 2:4]], axis=1)
+
+
 def corner_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """IoU (len(a), len(b)) of boxes x1, y1, x2, y2, computed as the SORT reference code does."""
     w = np.maximum(0.0, np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]))

@@ -294,11 +294,15 @@ def search_space(name: str, fixed: Mapping = ()) -> dict[str, Param]:
             and all(switch in searched or value(switch) == wanted for switch, wanted in p.needs.items())}
 
 
+NAMESPACES = ("roboflow",)  # registered names of two parts: 'roboflow:sort'
+
+
 def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
     """'sort:max_age=3,min_hits=1' -> ('sort', {'max_age': '3', 'min_hits': '1'}); a tracker named by location keeps
-    its class: './mine.py:Mine:gain=2' -> ('./mine.py:Mine', {'gain': '2'})."""
+    its class: './mine.py:Mine:gain=2' -> ('./mine.py:Mine', {'gain': '2'}), and one in a namespace its second part:
+    'roboflow:sort:lost_track_buffer=60' -> ('roboflow:sort', {'lost_track_buffer': '60'})."""
     name, _, rest = str(spec).partition(":")
-    if plugins.is_location(name.strip()):
+    if plugins.is_location(name.strip()) or name.strip().lower() in NAMESPACES:
         class_name, _, rest = rest.partition(":")
         name = f"{name.strip()}:{class_name.strip()}"
     params: dict[str, str] = {}

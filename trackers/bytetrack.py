@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import lapjv, plus_one_iou
+from .assignment import corners, lapjv, plus_one_iou
 from .base import Param, Tracker, Tracks, detections, register
 from .kalman import xyah_initiate, xyah_predict, xyah_update
 
@@ -49,8 +49,8 @@ class ByteTrack(Tracker):
         p = self.params
         dets = detections(obs)
         self.frame += 1
-        corners = np.c_[dets[:, :2], dets[:, :2] + dets[:, 2:4]]  # the reference is given x1, y1, x2, y2
-        tlwh = np.c_[corners[:, :2], corners[:, 2:] - corners[:, :2]]
+        xyxy = corners(dets)  # the reference is given x1, y1, x2, y2
+        tlwh = np.concatenate([xyxy[:, :2], xyxy[:, 2:] - xyxy[:, :2]], axis=1)
         score = dets[:, 4]
         high = np.flatnonzero(score > p["track_thresh"])
         low = np.flatnonzero((score > 0.1) & (score < p["track_thresh"]))
@@ -110,8 +110,7 @@ class ByteTrack(Tracker):
         """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks
         `rows` and detections by 1 - IoU (times the score unless mot20 or `score` is None), capped at `limit`."""
         boxes = self._tlwh(rows)
-        cost = 1 - plus_one_iou(np.c_[boxes[:, :2], boxes[:, :2] + boxes[:, 2:]],
-                                np.c_[tlwh[:, :2], tlwh[:, :2] + tlwh[:, 2:]])
+        cost = 1 - plus_one_iou(corners(boxes), corners(tlwh))
         if score is not None and not self.params["mot20"] and cost.size:
             cost = 1 - (1 - cost) * score[None, :]
         return lapjv(cost, limit)
@@ -121,26 +120,21 @@ class ByteTrack(Tracker):
         if they were lost)."""
         if not rows:
             return
-        box = tlwh[dets]
-        z = np.c_[box[:, :2] + box[:, 2:] / 2, box[:, 2] / box[:, 3], box[:, 3]]
-        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], z)
+        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], _xyah(tlwh[dets]))
         self.state[rows], self.activated[rows], self.score[rows], self.last_frame[rows] = TRACKED, True, score[dets], \
             self.frame
 
     def _start(self, tlwh: np.ndarray, score: np.ndarray) -> list[int]:
         """New tracks (rows appended), activated at once only in the first frame."""
         n = len(tlwh)
-        z = np.c_[tlwh[:, :2] + tlwh[:, 2:] / 2, tlwh[:, 2] / tlwh[:, 3], tlwh[:, 3]]
-        mean, cov = xyah_initiate(z)
+        mean, cov = xyah_initiate(_xyah(tlwh))
         first = len(self.ids)
-        self.mean, self.cov = np.r_[self.mean, mean], np.r_[self.cov, cov]
-        self.ids = np.r_[self.ids, np.arange(self.next_id, self.next_id + n)]
+        grow = {"mean": mean, "cov": cov, "ids": np.arange(self.next_id, self.next_id + n),
+                "state": np.full(n, TRACKED, np.int8), "activated": np.full(n, self.frame == 1), "score": score,
+                "last_frame": np.full(n, self.frame), "start_frame": np.full(n, self.frame)}
+        for name, new in grow.items():
+            setattr(self, name, np.concatenate([getattr(self, name), new]))
         self.next_id += n
-        self.state = np.r_[self.state, np.full(n, TRACKED, np.int8)]
-        self.activated = np.r_[self.activated, np.full(n, self.frame == 1)]
-        self.score = np.r_[self.score, score]
-        self.last_frame = np.r_[self.last_frame, np.full(n, self.frame)]
-        self.start_frame = np.r_[self.start_frame, np.full(n, self.frame)]
         return list(range(first, first + n))
 
     def _rearrange(self, activated, refound, lost_now, removed_now) -> None:
@@ -157,8 +151,7 @@ class ByteTrack(Tracker):
         if not tracked or not lost:
             return tracked, lost
         a, b = self._tlwh(tracked), self._tlwh(lost)
-        close = np.argwhere(1 - plus_one_iou(np.c_[a[:, :2], a[:, :2] + a[:, 2:]], np.c_[b[:, :2], b[:, :2] + b[:, 2:]])
-                            < 0.15)
+        close = np.argwhere(1 - plus_one_iou(corners(a), corners(b)) < 0.15)
         age = self.last_frame - self.start_frame
         drop_a = {p for p, q in close if not age[tracked[p]] > age[lost[q]]}
         drop_b = {q for p, q in close if age[tracked[p]] > age[lost[q]]}
@@ -180,3 +173,9 @@ class ByteTrack(Tracker):
 def _joint(a: list[int], b: list[int]) -> list[int]:
     """The reference's joint_stracks: the rows of `a`, then those of `b` not in `a`."""
     return a + [r for r in dict.fromkeys(b) if r not in set(a)]
+
+
+def _xyah(tlwh: np.ndarray) -> np.ndarray:
+    """Boxes x, y, w, h -> the filter's measurement cx, cy, aspect w / h, height."""
+    return np.stack([tlwh[:, 0] + tlwh[:, 2] / 2, tlwh[:, 1] + tlwh[:, 3] / 2, tlwh[:, 2] / tlwh[:, 3], tlwh[:, 3]],
+                    axis=1)

@@ -69,7 +69,7 @@ def _variances(height: np.ndarray, weights: list[float], fixed: dict[int, float]
 def xyah_initiate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """New tracks at measurements z (n, 4) cx, cy, aspect, height: means (n, 8) and covariances (n, 8, 8)."""
     cov = _variances(z[:, 3], [2 * _POSITION] * 4 + [10 * _VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
-    return np.c_[z, np.zeros_like(z)], cov
+    return np.concatenate([z, np.zeros_like(z)], axis=1), cov
 
 
 def xyah_predict(mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

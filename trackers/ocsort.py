@@ -8,7 +8,7 @@ import numpy as np
 from .assignment import corner_iou, lapjv
 from .base import Param, Tracker, Tracks, detections, register
 from .kalman import KalmanBank, box_model, stop_shrinking_to_nothing
-from .sort import associate, state_to_corners
+from .sort import associate, state_to_corners, without
 
 NONE = -(2**62)  # the age of an empty slot in a track's recent observations
 NO_BOX = np.full(5, -1.0)  # the reference's placeholder for "no observation" (x1, y1, x2, y2, confidence)
@@ -56,6 +56,8 @@ class OcSort(Tracker):
         self.next_id, self.frame = 1, 0
 
     def _keep(self, mask: np.ndarray) -> None:
+        if mask.all():
+            return
         self.kf.keep(mask)
         for name in ("ids", "counts", "last", "recent_age", "recent", "velocity", "observed", "frozen", "saved_x",
                      "saved_P", "last_z"):
@@ -64,7 +66,7 @@ class OcSort(Tracker):
     def update(self, obs) -> Tracks:
         p = self.params
         dets = detections(obs)
-        dets = np.c_[dets[:, :2], dets[:, :2] + dets[:, 2:4], dets[:, 4]]  # the reference is given x1, y1, x2, y2
+        dets = np.concatenate([dets[:, :2], dets[:, :2] + dets[:, 2:4], dets[:, 4:]], axis=1)  # given x1, y1, x2, y2
         score = dets[:, 4]
         high = dets[score > p["det_thresh"]]
         low = dets[(score > 0.1) & (score < p["det_thresh"])]
@@ -89,23 +91,24 @@ class OcSort(Tracker):
             if found is not None:
                 d, t = found
                 pairs.append((low, d, left_tracks[t]))
-                left_tracks = np.setdiff1d(left_tracks, left_tracks[t])
+                left_tracks = np.sort(left_tracks[without(len(left_tracks), t)])
         if len(left_dets) and len(left_tracks):
             found = rematch(high[left_dets], self.last[left_tracks], p["iou_threshold"])
             if found is not None:
                 d, t = found
                 pairs.append((high, left_dets[d], left_tracks[t]))
-                left_dets, left_tracks = (np.setdiff1d(left_dets, left_dets[d]),
-                                          np.setdiff1d(left_tracks, left_tracks[t]))
-        for source, d, t in pairs:
-            self._observe(t, source[d], previous[t])
+                left_dets = np.sort(left_dets[without(len(left_dets), d)])  # the reference's setdiff1d sorts
+                left_tracks = np.sort(left_tracks[without(len(left_tracks), t)])
+        t = np.concatenate([t for _, _, t in pairs])
+        self._observe(t, np.concatenate([source[d] for source, d, _ in pairs]), previous[t])
         self._miss(left_tracks)
         self._start(high[left_dets])
 
         streak, misses = self.counts[:, 0], self.counts[:, 3]
         report = (misses < 1) & ((streak >= p["min_hits"]) | (self.frame <= p["min_hits"]))
         box = np.where((self.last.sum(axis=1) < 0)[:, None], state_to_corners(self.kf.x), self.last[:, :4])
-        out = Tracks.of(self.ids[report], np.c_[box[report, :2], box[report, 2:] - box[report, :2]])
+        box = box[report]
+        out = Tracks.of(self.ids[report], np.concatenate([box[:, :2], box[:, 2:] - box[:, :2]], axis=1))
         self._keep(misses <= p["max_age"])
         return out
 
@@ -127,7 +130,7 @@ class OcSort(Tracker):
         had = self.last[t].sum(axis=1) >= 0  # the reference's test for "observed before" (a box's sum, as it is)
         self.velocity[t[had]] = unit_direction(previous[had], boxes[had])
         self.last[t] = boxes
-        self.recent_age[t] = np.c_[self.recent_age[t, 1:], self.counts[t, 2]]
+        self.recent_age[t] = np.concatenate([self.recent_age[t, 1:], self.counts[t, 2:3]], axis=1)
         self.recent[t] = np.concatenate([self.recent[t, 1:], boxes[:, None]], axis=1)
         z = corners_to_z(boxes[:, :4])
         rewind = ~self.observed[t] & self.frozen[t]

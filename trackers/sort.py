@@ -60,6 +60,8 @@ class SortTracks:
         return len(self.ids)
 
     def _keep(self, mask: np.ndarray) -> None:
+        if mask.all():
+            return
         self.kf.keep(mask)
         self.ids, self.counts, self.last = self.ids[mask], self.counts[mask], self.last[mask]
 
@@ -133,9 +135,16 @@ def associate(dets: np.ndarray, tracks: np.ndarray, threshold: float,
         matched = np.zeros((0, 2), np.intp)
     low = iou[matched[:, 0], matched[:, 1]] < threshold
     # never paired, then paired but under the threshold
-    left_dets = np.concatenate([np.setdiff1d(np.arange(len(dets)), matched[:, 0]), matched[low, 0]])
-    left_tracks = np.concatenate([np.setdiff1d(np.arange(len(tracks)), matched[:, 1]), matched[low, 1]])
+    left_dets = np.concatenate([without(len(dets), matched[:, 0]), matched[low, 0]])
+    left_tracks = np.concatenate([without(len(tracks), matched[:, 1]), matched[low, 1]])
     return matched[~low], left_dets.astype(np.intp), left_tracks.astype(np.intp)
+
+
+def without(n: int, rows: np.ndarray) -> np.ndarray:
+    """0..n-1 in order, less `rows` (np.setdiff1d(np.arange(n), rows), without its sorting)."""
+    keep = np.ones(n, bool)
+    keep[rows] = False
+    return np.flatnonzero(keep)
 
 
 def corners_to_measurement(corners: np.ndarray) -> np.ndarray:

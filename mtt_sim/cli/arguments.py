@@ -118,7 +118,7 @@ def tracker_specs(text: str) -> list[str]:
             raise argparse.ArgumentTypeError(str(err)) from None
         name = trackers.parse_spec(spec)[0]
         if not trackers.base.plugins.is_location(name):  # a registered one by its name as registered
-            spec = tracker.name + spec[len(spec.partition(":")[0]):]
+            spec = tracker.name + spec.strip()[len(name):]
         canonical.append(spec)
     return canonical
 

@@ -95,10 +95,15 @@ def tracker_page(name: str) -> str:
                       "command line.", "", *rows, ""])
 
 
+def page_name(tracker: str) -> str:
+    """A tracker's page's file name: 'roboflow:sort' -> 'roboflow-sort' (a colon in a link reads as a URL scheme)."""
+    return tracker.replace(":", "-")
+
+
 def nav_lines(keys: list[str], names: list[str]) -> list[str]:
     """NAV as mkdocs.yml lines, the generated pages spelled out: one per scenario `keys`, per tracker `names`."""
     generated = {"scenarios/": [(k, f"scenarios/{k}.md") for k in keys],
-                 "trackers/": [(n, f"trackers/{n}.md") for n in names]}
+                 "trackers/": [(n, f"trackers/{page_name(n)}.md") for n in names]}
     lines = []
     for title, item in NAV:
         if isinstance(item, str):
@@ -123,7 +128,7 @@ def write_sources(folder: Path) -> None:
         (docs / "scenarios" / f"{key}.md").write_text(scenario_page(key, docs / "scenarios"))
     names = sorted(trackers.base.REGISTRY)
     for name in names:
-        (docs / "trackers" / f"{name}.md").write_text(tracker_page(name))
+        (docs / "trackers" / f"{page_name(name)}.md").write_text(tracker_page(name))
     (folder / "mkdocs.yml").write_text("\n".join(["site_name: mtt-sim", "theme:", "  name: material", "nav:",
                                                   *nav_lines(keys, names), ""]))
 
