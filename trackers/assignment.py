@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import heapq
 
+import lap
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.special import chdtri
@@ -29,9 +30,9 @@ def plus_one_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     iw = np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]) + 1
     ih = np.minimum(a[:, None, 3], b[:, 3]) - np.maximum(a[:, None, 1], b[:, 1]) + 1
     area_a, area_b = (a[:, 2] - a[:, 0] + 1) * (a[:, 3] - a[:, 1] + 1), (b[:, 2] - b[:, 0] + 1) * (b[:, 3] - b[:, 1] + 1)
-    overlap = (iw > 0) & (ih > 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(overlap, iw * ih / (area_a[:, None] + area_b - iw * ih), 0.0)
+    inter = iw * ih
+    out = np.zeros(inter.shape)
+    return np.divide(inter, area_a[:, None] + area_b - inter, out=out, where=(iw > 0) & (ih > 0))
 
 
 def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -39,8 +40,6 @@ def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarr
     `cost`, where leaving a row or a column unassigned costs limit / 2: what lap.lapjv(cost, extend_cost=True,
     cost_limit=limit) finds, as the SORT and ByteTrack reference codes call it. It is `lap` that is called (not
     scipy), because among equal-cost assignments the reference outputs depend on the one it picks."""
-    import lap  # imported here: only these two baselines need it
-
     n, m = cost.shape
     if not cost.size:
         return np.zeros((0, 2), np.intp), np.arange(n), np.arange(m)

@@ -97,8 +97,12 @@ class ByteTrack(Tracker):
     def _tlwh(self, rows) -> np.ndarray:
         """Boxes x, y, w, h of track rows, from their means (cx, cy, aspect, height)."""
         m = self.mean[rows]
-        w = m[:, 2] * m[:, 3]
-        return np.stack([m[:, 0] - w / 2, m[:, 1] - m[:, 3] / 2, w, m[:, 3]], axis=1)
+        out = np.empty((len(m), 4))
+        out[:, 2] = m[:, 2] * m[:, 3]
+        out[:, 0] = m[:, 0] - out[:, 2] / 2
+        out[:, 1] = m[:, 1] - m[:, 3] / 2
+        out[:, 3] = m[:, 3]
+        return out
 
     def _predict(self, rows: list[int]) -> None:
         if rows:
@@ -109,8 +113,9 @@ class ByteTrack(Tracker):
     def _associate(self, rows: list[int], tlwh: np.ndarray, score: np.ndarray | None, limit: float):
         """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks
         `rows` and detections by 1 - IoU (times the score unless mot20 or `score` is None), capped at `limit`."""
-        boxes = self._tlwh(rows)
-        cost = 1 - plus_one_iou(corners(boxes), corners(tlwh))
+        if not rows or not len(tlwh):
+            return np.zeros((0, 2), np.intp), np.arange(len(rows)), np.arange(len(tlwh))
+        cost = 1 - plus_one_iou(corners(self._tlwh(rows)), corners(tlwh))
         if score is not None and not self.params["mot20"] and cost.size:
             cost = 1 - (1 - cost) * score[None, :]
         return lapjv(cost, limit)
@@ -127,6 +132,8 @@ class ByteTrack(Tracker):
     def _start(self, tlwh: np.ndarray, score: np.ndarray) -> list[int]:
         """New tracks (rows appended), activated at once only in the first frame."""
         n = len(tlwh)
+        if not n:
+            return []
         mean, cov = xyah_initiate(_xyah(tlwh))
         first = len(self.ids)
         grow = {"mean": mean, "cov": cov, "ids": np.arange(self.next_id, self.next_id + n),
@@ -177,5 +184,8 @@ def _joint(a: list[int], b: list[int]) -> list[int]:
 
 def _xyah(tlwh: np.ndarray) -> np.ndarray:
     """Boxes x, y, w, h -> the filter's measurement cx, cy, aspect w / h, height."""
-    return np.stack([tlwh[:, 0] + tlwh[:, 2] / 2, tlwh[:, 1] + tlwh[:, 3] / 2, tlwh[:, 2] / tlwh[:, 3], tlwh[:, 3]],
-                    axis=1)
+    out = np.empty((len(tlwh), 4))
+    out[:, :2] = tlwh[:, :2] + tlwh[:, 2:4] / 2
+    out[:, 2] = tlwh[:, 2] / tlwh[:, 3]
+    out[:, 3] = tlwh[:, 3]
+    return out

@@ -61,7 +61,8 @@ def main(data: str | None) -> None:
             lines.append(f"scenario {key} seed {seed}: {episode(env, 'sort', seed, STEPS)}")
     if data:
         folders = sorted(Path(data, "mot15").iterdir())
-        for spec in [*sorted(trackers.available()), "lmb:reid=false"]:  # lmb's re-id reads frames, which these lack
+        ours = [n for n in sorted(trackers.available()) if not n.startswith("roboflow:")]  # peers: docs/peers.md
+        for spec in [*ours, "lmb:reid=false"]:  # lmb's re-id reads frames, which these lack
             for folder in folders:
                 try:
                     env = mtt_sim.TrackingEnv(sequence=folder)

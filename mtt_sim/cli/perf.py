@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from mtt_sim.cli.arguments import integer
 
 
@@ -10,7 +12,21 @@ def add(subparsers) -> None:
                                            "same-run reference")
     p.add_argument("--repeats", type=integer(1), default=5, help="medians over this many repeats (default 5)")
     p.add_argument("--steps", type=integer(1), default=200, help="env steps per repeat (default 200)")
+    p.add_argument("--sections", type=sections, default=None,
+                   help=f"only these tables, comma-separated: {', '.join(SECTIONS)} (default all)")
     p.set_defaults(func=run)
+
+
+SECTIONS = ("env", "scenarios", "scaling", "metrics", "metrics memory", "jpda", "lmb", "rfs", "baselines",
+            "particle filters", "sweeps")
+
+
+def sections(text: str) -> list[str]:
+    chosen = [s.strip() for s in text.split(",") if s.strip()]
+    unknown = [s for s in chosen if s not in SECTIONS]
+    if not chosen or unknown:
+        raise argparse.ArgumentTypeError(f"{text!r}: sections are {', '.join(SECTIONS)}")
+    return chosen
 
 
 def run(args) -> int:
@@ -26,8 +42,10 @@ def run(args) -> int:
                 ("jpda", lambda: perf.report_jpda(perf.measure_jpda(repeats=args.repeats))),
                 ("lmb", lambda: perf.report_lmb(perf.measure_lmb(repeats=args.repeats))),
                 ("rfs", lambda: perf.report_rfs(perf.measure_rfs(repeats=args.repeats))),
+                ("baselines", lambda: perf.report_baselines(perf.measure_baselines(repeats=args.repeats))),
                 ("particle filters", lambda: perf.report_pf(perf.measure_pf(repeats=args.repeats))),
                 ("sweeps", lambda: perf.report_sweeps(perf.measure_sweeps(repeats=args.repeats)))]
+    sections = [(name, measure) for name, measure in sections if args.sections is None or name in args.sections]
     with tqdm(sections, unit="section", leave=False) as bar:
         for name, measure in bar:
             bar.set_description(f"measuring {name}")

@@ -13,6 +13,7 @@ import statistics
 import time
 import tracemalloc
 from collections import Counter
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -310,6 +311,54 @@ def report_lmb(rows: list[dict]) -> str:
                                   "gnn ms/frame", "lmb:reid=false / gnn"],
                   [[r["targets"], f"{r['detections']:.1f}", f"{r['lmb_ms']:.2f}", f"{r['lmb_reid_ms']:.2f}",
                     f"{r['gnn_ms']:.2f}", f"{r['lmb_over_gnn']:.2f}x"] for r in rows])
+
+
+BASELINE_PEERS = {"sort": "SORTTracker", "bytetrack": "ByteTrackTracker", "ocsort": "OCSORTTracker"}
+BASELINE_WORKLOADS = (("mot17_like", {}), ("dense", {"groups.0.count": 60, "sensor.pd": 0.9,
+                                                    "sensor.clutter_rate": 5.0}))
+
+
+def measure_baselines(repeats: int = 5, frames: int = 300, workloads=BASELINE_WORKLOADS) -> list[dict]:
+    """Medians of the published baselines' frames per second of tracker time on the recorded detections of each
+    workload (a scenario or sequence folder, and its config), beside Roboflow's same tracker (its update() on
+    supervision Detections built beforehand) where its package is installed (the [peers] extra), in the same run."""
+    try:
+        package = trackers.roboflow.roboflow_package()
+        from supervision import Detections
+    except ImportError:
+        package = None
+    rows = []
+    for source, config in workloads:
+        rec = _recorded(source, frames, config, "detections")
+        n = len(rec[1])
+        for ours, theirs in BASELINE_PEERS.items():
+            runs = []
+            for _ in range(repeats):
+                peer = float("nan")
+                if package is not None:
+                    model = getattr(package, theirs)()
+                    dets = [trackers.roboflow.as_detections(Detections, trackers.base.detections(o)) for o in rec[1]]
+                    peer = n / _time(lambda: [model.update(d) for d in dets])
+                runs.append((1e3 / _ms_per_frame(ours, rec), peer))
+            fps, peer = (statistics.median(r[i] for r in runs) for i in range(2))
+            rows.append({"tracker": ours, "workload": Path(str(source)).name, "fps": fps, "roboflow_fps": peer})
+    return rows
+
+
+def report_baselines(rows: list[dict]) -> str:
+    peer = not all(np.isnan(r["roboflow_fps"]) for r in rows)
+    return _table("published baselines, tracker time only, medians (reference: Roboflow's same tracker, "
+                  + ("trackers " + metadata_version("trackers") if peer else "not installed: the [peers] extra")
+                  + ")", ["tracker", "workload", "frames/s", "Roboflow frames/s", "ours / Roboflow"],
+                  [[r["tracker"], r["workload"], f"{r['fps']:.0f}"]
+                   + ([f"{r['roboflow_fps']:.0f}", f"{r['fps'] / r['roboflow_fps']:.2f}x"] if peer else ["", ""])
+                   for r in rows], left=2)
+
+
+def metadata_version(package: str) -> str:
+    from importlib import metadata
+
+    return metadata.version(package)
 
 
 RFS_WORKLOADS = (("mot17_like", {}, ("gmphd",)),
