@@ -50,6 +50,36 @@ def test_candidates_keep_an_id_while_kept_and_start_afresh_when_dropped():
     assert kept.decide([False], [True])[0].size == 0
 
 
+def test_bytetrack_candidates_take_low_confidence_detections_only_while_tracked():
+    """ByteTrack's association: a detection under track_thresh (0.5) starts nothing, but continues a candidate matched
+    the frame before (its second round); after a missed frame it no longer does."""
+    high, low = np.array([[10.0, 10.0, 20.0, 40.0, 0.9]]), np.array([[11.0, 10.0, 20.0, 40.0, 0.3]])
+    c = Candidates((100, 80), base="bytetrack")
+    assert len(c.propose(low)) == 0
+    c.propose(high)
+    features = c.propose(low)
+    assert features[0, FEATURES.index("matched")] == 1 and features[0, FEATURES.index("confidence")] == 0.3
+    assert features[0, FEATURES.index("streak")] == pytest.approx(0.1)  # one match after the birth
+    assert c.decide([True], [True])[0].tolist() == [1]
+    c.propose(np.zeros((0, 5)))
+    c.decide([False], [True])
+    assert c.propose(low)[0, FEATURES.index("matched")] == 0  # missed last frame: not in the second round
+    assert c.propose(high)[0, FEATURES.index("matched")] == 1  # a high detection finds it again (first round)
+
+
+def test_learned_tracker_runs_on_either_base_through_gym():
+    for base in ("sort", "bytetrack"):
+        m = trackers.make(f"learned:base={base}")
+        env = gym.make("mtt_sim/Mot17Like-v0", config={"env.max_steps": 40})
+        obs, info = env.reset(seed=0)
+        m.reset(info)
+        while True:
+            obs, _, terminated, truncated, info = env.step(m.update(obs).to_action(env.action_space))
+            if terminated or truncated:
+                break
+        assert info["metrics"]["MOTA"] > 0.5, base
+
+
 def test_sort_rules_decide_as_sort_does():
     def features(matched, streak, misses, first):
         row = np.zeros(len(FEATURES), np.float32)
@@ -88,12 +118,13 @@ def test_management_env_with_sort_rules_returns_sorts_mota():
     assert total / sort["num_gt_dets"] == pytest.approx(sort["MOTA"])
 
 
-def test_management_env_passes_the_checker_and_runs_vectorised():
+@pytest.mark.parametrize("base", ["sort", "bytetrack"])
+def test_management_env_passes_the_checker_and_runs_vectorised(base):
     env = gym.make("mtt_sim/TrackManagement-v0", scenario="crossing", render_mode="rgb_array",
-                   config={"env.max_steps": 30})
+                   config={"env.max_steps": 30}, base=base)
     check_env(env.unwrapped)
     envs = gym.make_vec("mtt_sim/TrackManagement-v0", num_envs=2, scenario="crossing",
-                        config={"env.max_steps": 20})
+                        config={"env.max_steps": 20}, base=base)
     obs, _ = envs.reset(seed=[0, 1])
     assert obs["features"].shape == (2, 64, len(FEATURES))
     obs, reward, *_ = envs.step(np.ones((2, 128), np.int8))
@@ -134,8 +165,8 @@ def test_management_env_rejects_bad_actions_and_arguments():
         env.step(np.ones((3, 2), np.int8))
     with pytest.raises(ValueError, match="expected 0 or 1"):
         env.step(np.full((64, 2), 2))
-    with pytest.raises(ValueError, match="base='bytetrack': allowed: 'sort'"):
-        gym.make("mtt_sim/TrackManagement-v0", base="bytetrack")
+    with pytest.raises(ValueError, match="base='deepsort': allowed: 'sort', 'bytetrack'"):
+        gym.make("mtt_sim/TrackManagement-v0", base="deepsort")
     with pytest.raises(ValueError, match="max_candidates=0"):
         gym.make("mtt_sim/TrackManagement-v0", max_candidates=0)
 

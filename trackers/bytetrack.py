@@ -96,13 +96,7 @@ class ByteTrack(Tracker):
 
     def _tlwh(self, rows) -> np.ndarray:
         """Boxes x, y, w, h of track rows, from their means (cx, cy, aspect, height)."""
-        m = self.mean[rows]
-        out = np.empty((len(m), 4))
-        out[:, 2] = m[:, 2] * m[:, 3]
-        out[:, 0] = m[:, 0] - out[:, 2] / 2
-        out[:, 1] = m[:, 1] - m[:, 3] / 2
-        out[:, 3] = m[:, 3]
-        return out
+        return xyah_to_tlwh(self.mean[rows])
 
     def _predict(self, rows: list[int]) -> None:
         if rows:
@@ -125,7 +119,7 @@ class ByteTrack(Tracker):
         if they were lost)."""
         if not rows:
             return
-        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], _xyah(tlwh[dets]))
+        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], tlwh_to_xyah(tlwh[dets]))
         self.state[rows], self.activated[rows], self.score[rows], self.last_frame[rows] = TRACKED, True, score[dets], \
             self.frame
 
@@ -134,7 +128,7 @@ class ByteTrack(Tracker):
         n = len(tlwh)
         if not n:
             return []
-        mean, cov = xyah_initiate(_xyah(tlwh))
+        mean, cov = xyah_initiate(tlwh_to_xyah(tlwh))
         first = len(self.ids)
         grow = {"mean": mean, "cov": cov, "ids": np.arange(self.next_id, self.next_id + n),
                 "state": np.full(n, TRACKED, np.int8), "activated": np.full(n, self.frame == 1), "score": score,
@@ -182,7 +176,17 @@ def _joint(a: list[int], b: list[int]) -> list[int]:
     return a + [r for r in dict.fromkeys(b) if r not in set(a)]
 
 
-def _xyah(tlwh: np.ndarray) -> np.ndarray:
+def xyah_to_tlwh(m: np.ndarray) -> np.ndarray:
+    """Filter means (cx, cy, aspect, height, ...) -> boxes x, y, w, h."""
+    out = np.empty((len(m), 4))
+    out[:, 2] = m[:, 2] * m[:, 3]
+    out[:, 0] = m[:, 0] - out[:, 2] / 2
+    out[:, 1] = m[:, 1] - m[:, 3] / 2
+    out[:, 3] = m[:, 3]
+    return out
+
+
+def tlwh_to_xyah(tlwh: np.ndarray) -> np.ndarray:
     """Boxes x, y, w, h -> the filter's measurement cx, cy, aspect w / h, height."""
     out = np.empty((len(tlwh), 4))
     out[:, :2] = tlwh[:, :2] + tlwh[:, 2:4] / 2

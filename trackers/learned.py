@@ -1,5 +1,6 @@
-"""The learned tracker: SORT's candidates (`management.Candidates`) with a learned linear policy deciding which to
-report and which to keep, in place of SORT's min_hits and max_age. `mtt-sim learn-policy` trains the policy."""
+"""The learned tracker: a base tracker's candidates (`management.Candidates`: SORT's or ByteTrack's association) with a
+learned linear policy deciding which to report and which to keep, in place of the base's rules (SORT's min_hits and
+max_age). `mtt-sim learn-policy` trains the policy."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .base import Param, Tracker, Tracks, detections, register
-from .management import FEATURES, SORT_RULES, Candidates, decisions
+from .management import BASES, FEATURES, SORT_RULES, Candidates, decisions
 
 SHIPPED_POLICY = Path(__file__).with_name("data") / "policy_sort.npz"
 
@@ -37,15 +38,16 @@ def save_policy(path: str | Path, weights: np.ndarray, **about: str) -> None:
 
 @register
 class Learned(Tracker):
-    """Track management learned from the reward: each frame SORT's association proposes candidates, and a linear
-    policy over their features (`management.FEATURES`) decides to report each and to keep it. `policy=sort_rules`
-    is SORT's own rules (min_hits=3, max_age=1) in that form: then the tracker equals SORT box for box."""
+    """Track management learned from the reward: each frame the base's association (SORT's, or ByteTrack's with its
+    low-confidence round) proposes candidates, and a linear policy over their features (`management.FEATURES`)
+    decides to report each and to keep it. `policy=sort_rules` is SORT's own rules (min_hits=3, max_age=1) in that
+    form: with base=sort the tracker then equals SORT box for box. The shipped policy was trained with base=sort."""
 
     name = "learned"
     description = "SORT's candidates with a learned report / keep policy (Xiang et al. 2015's decisions, by CMA-ES)"
     parameters = {
         "policy": Param("", None, "a policy file from mtt-sim learn-policy; '' the shipped one, sort_rules SORT's rules"),
-        "base": Param("sort", ("sort",), "the tracker whose association proposes the candidates"),
+        "base": Param("sort", BASES, "the tracker whose association proposes the candidates"),
         "iou_threshold": Param(0.3, "[0, 1]", "least IoU of a match"),
     }
 
@@ -55,7 +57,7 @@ class Learned(Tracker):
 
     def reset(self, info=None):
         size = (info or {}).get("image_size", (1920, 1080))
-        self.candidates = Candidates(tuple(size), self.params["iou_threshold"])
+        self.candidates = Candidates(tuple(size), self.params["iou_threshold"], base=self.params["base"])
 
     def update(self, obs) -> Tracks:
         features = self.candidates.propose(detections(obs))

@@ -100,6 +100,11 @@ class SortTracks:
         box[:, 2:] -= box[:, :2]
         return box
 
+    def motion(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per track, the area's relative change and the centre's speed in pixels, per frame."""
+        x = self.kf.x
+        return x[:, 6] / np.maximum(x[:, 2], 1e-6), np.hypot(x[:, 4], x[:, 5])
+
     def decide(self, report: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The reported candidates' (ids, boxes), then drop those not kept."""
         report, keep = np.asarray(report, bool), np.asarray(keep, bool)

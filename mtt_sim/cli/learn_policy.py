@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from mtt_sim.cli.arguments import (
     CONFIG_HELP,
     FORCE_HELP,
@@ -17,14 +19,16 @@ from mtt_sim.cli.arguments import (
 
 
 def add(subparsers) -> None:
-    p = subparsers.add_parser("learn-policy", help="learn which of SORT's candidate tracks to report and keep, from the "
-                                                   "score (CMA-ES; the `learned` tracker)")
+    p = subparsers.add_parser("learn-policy", help="learn which of a base tracker's candidate tracks to report and "
+                                                   "keep, from the score (CMA-ES; the `learned` tracker)")
     p.add_argument("--on", type=scenario_keys, required=True, metavar="SOURCE[,SOURCE...]",
                    help="scenarios, scenario files, sequence folders (twins with --detector synthetic)")
     p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1000-1003"),
                    help="training episodes per simulated source: a count, list or range (default 1000-1003, away from "
                         "the experiments' 0..9)")
     p.add_argument("--frames", type=integer(1), help="cut each training episode to this many frames")
+    p.add_argument("--base", type=base_name, default="sort",
+                   help="the tracker whose association proposes the candidates: sort or bytetrack (default sort)")
     p.add_argument("--generations", type=integer(1), default=20, help="CMA-ES generations (default 20)")
     p.add_argument("--population", type=integer(4), help="policies a generation (default: CMA-ES's for 30 weights, 14)")
     p.add_argument("--sigma", type=float, default=1.0, help="CMA-ES's first step size on the weights (default 1)")
@@ -36,6 +40,14 @@ def add(subparsers) -> None:
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     add_overrides(p, CONFIG_HELP)
     p.set_defaults(func=run)
+
+
+def base_name(text: str) -> str:
+    from mtt_sim.trackers.management import BASES
+
+    if text not in BASES:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed: {', '.join(BASES)}")
+    return text
 
 
 def run(args) -> int:
@@ -56,12 +68,13 @@ def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".npz",))
     plot = output_file(args.plot, args.force, "--plot", (".png",))
     learning = learn_policy(args.on, args.seeds, args.generations, args.population, args.sigma, args.seed,
-                            args.workers, metrics, overrides, args.frames, progress=True)
-    save_policy(out, learning.weights, trained_on=",".join(args.on), seeds=str(list(args.seeds)),
+                            args.workers, metrics, overrides, args.frames, progress=True, base=args.base)
+    save_policy(out, learning.weights, trained_on=",".join(args.on), seeds=str(list(args.seeds)), base=args.base,
                 metrics=",".join(metrics), generations=str(args.generations), seed=str(args.seed))
     print(f"fitness (mean {'/'.join(metrics)} over {learning.episodes} episodes): SORT's rules {learning.start_fitness:.4f}, "
           f"learned {learning.fitness:.4f}")
-    print(f"wrote {out}: use it with --tracker 'learned:policy={out}'")
+    print(f"wrote {out}: use it with --tracker 'learned:policy={out}" + (f",base={args.base}'" if args.base != "sort"
+                                                                           else "'"))
     if plot:
         from mtt_sim.lab.plots import learning_curve
 

@@ -1,8 +1,8 @@
 """TrackManagementEnv: track management as a Gymnasium decision process over the tracking env.
 
-Each frame SORT's association proposes candidate tracks (`trackers.management.Candidates`); the agent decides for
-each candidate whether to report it this frame and whether to keep it alive. The reward is the tracking env's reward
-for the reported tracks, unchanged (by default TP - FP - IDSW: the return over the ground-truth count is MOTA).
+Each frame a base tracker's association (`base="sort"`, or `"bytetrack"`) proposes candidate tracks
+(`trackers.management.Candidates`); the agent decides for each candidate whether to report it this frame and whether
+to keep it alive. The reward is the tracking env's reward for the reported tracks, unchanged (by default TP - FP - IDSW: the return over the ground-truth count is MOTA).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from gymnasium import spaces
 
 from mtt_sim.env import TrackingEnv
 from mtt_sim.trackers.base import detections
-from mtt_sim.trackers.management import FEATURES, Candidates
+from mtt_sim.trackers.management import BASES, FEATURES, Candidates
 
 DECISION_COLOURS = {"report": (40, 200, 40), "keep": (230, 200, 40), "drop": (220, 50, 50)}
 
@@ -34,13 +34,15 @@ class TrackManagementEnv(gym.Env):
 
     def __init__(self, scenario: Any = "mot17_like", config: Mapping | None = None, render_mode: str | None = None,
                  max_candidates: int = 64, base: str = "sort", iou_threshold: float = 0.3, **env_kwargs):
-        if base != "sort":
-            raise ValueError(f"base={base!r}: allowed: 'sort' (the tracker whose association proposes candidates)")
+        if base not in BASES:
+            raise ValueError(f"base={base!r}: allowed: {', '.join(map(repr, BASES))} (the tracker whose association "
+                             "proposes candidates)")
         if not isinstance(max_candidates, int) or not 1 <= max_candidates <= 4096:
             raise ValueError(f"max_candidates={max_candidates!r}: allowed: an integer from 1 to 4096")
         self.tracking = TrackingEnv(scenario, config=config, render_mode=render_mode,
                                     obs_mode="frame+detections" if render_mode else "detections", **env_kwargs)
-        self.render_mode, self.max_candidates, self.iou_threshold = render_mode, max_candidates, iou_threshold
+        self.render_mode, self.max_candidates, self.iou_threshold, self.base = (render_mode, max_candidates,
+                                                                                iou_threshold, base)
         self.observation_space = spaces.Dict({
             "features": spaces.Box(-1.0, 1.0, (max_candidates, len(FEATURES)), np.float32),
             "mask": spaces.MultiBinary(max_candidates)})
@@ -50,7 +52,7 @@ class TrackManagementEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: Mapping | None = None):
         super().reset(seed=seed)
         obs, info = self.tracking.reset(seed=seed, options=options)
-        self.candidates = Candidates(tuple(info["image_size"]), self.iou_threshold, self.max_candidates)
+        self.candidates = Candidates(tuple(info["image_size"]), self.iou_threshold, self.max_candidates, self.base)
         return self._observe(obs), info
 
     def _observe(self, obs: Mapping) -> dict[str, np.ndarray]:

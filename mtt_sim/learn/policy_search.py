@@ -62,9 +62,10 @@ def replays(sources: Sequence[str], seeds: Sequence[int], folder: Path, config: 
 def learn_policy(sources: Sequence[str], seeds: Sequence[int] = (0,), generations: int = 20,
                  population: int | None = None, sigma: float = 1.0, seed: int = 0, workers: int = 1,
                  metrics: Sequence[str] = ("MOTA", "HOTA"), config: Mapping | None = None, steps: int | None = None,
-                 progress: bool = False) -> Learning:
+                 progress: bool = False, base: str = "sort") -> Learning:
     """CMA-ES over the policy's weights from SORT's rules, `generations` generations of `population` policies (None:
-    CMA-ES's default for the dimension), on `sources` x `seeds` (with `config` overrides, cut to `steps` frames)."""
+    CMA-ES's default for the dimension), on `sources` x `seeds` (with `config` overrides, cut to `steps` frames), the
+    candidates proposed by `base`'s association."""
     from cmaes import CMA
 
     if generations < 1:
@@ -80,7 +81,8 @@ def learn_policy(sources: Sequence[str], seeds: Sequence[int] = (0,), generation
                 tasks = []
                 for k, w in enumerate(weights):
                     save_policy(folder / f"policy{k}.npz", w.reshape(SORT_RULES.shape))
-                    tasks += [(e, f"learned:policy={folder / f'policy{k}.npz'}", 0, {}, None) for e in episodes]
+                    spec = f"learned:policy={folder / f'policy{k}.npz'},base={base}"
+                    tasks += [(e, spec, 0, {}, None) for e in episodes]
                 records = run_tasks(tasks, workers, processes=processes)
                 return [_score(records[k * len(episodes):(k + 1) * len(episodes)], metrics) for k in range(len(weights))]
 
