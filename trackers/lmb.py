@@ -11,6 +11,7 @@ from . import gaussian_mixture as gm
 from . import reid
 from .assignment import chi2_gate, murty
 from .base import Param, Tracker, Tracks, covariance_ellipse, detections, frame_of, register
+from .camera_motion import METHODS, CameraMotion, warp_boxes, warp_centres
 from .jpda import clusters
 
 EPS = 1e-12
@@ -169,6 +170,8 @@ class LabelledMultiBernoulli(Tracker):
                                                 "drops them)"),
         "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
         "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
+        "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper; see "
+                                      "camera_motion.py): the predictions and last frame's births moved with the image"),
         "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool",
                                  (0.3, 0.95), needs={"reid": True}),
         "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log"),
@@ -179,7 +182,7 @@ class LabelledMultiBernoulli(Tracker):
 
     @property
     def needs_frame(self) -> bool:
-        return bool(self.params["reid"])
+        return bool(self.params["reid"]) or self.params["cmc"] != "none"
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -200,6 +203,7 @@ class LabelledMultiBernoulli(Tracker):
         self.tracks = _Mixture()
         self.pending = (np.zeros((0, 4)), np.zeros(0))  # births for the next frame: boxes, r_B
         self.next_label, self.frame = 1, 0
+        self.camera = CameraMotion(p["cmc"])
         self.pool = None                      # made at the first frame, sized by its target count
         self.reported: set[int] = set()
 
@@ -247,6 +251,10 @@ class LabelledMultiBernoulli(Tracker):
         self.frame += 1
         t.r = t.r * p["survival"]
         t.m, t.P = gm.predict(t.m, t.P, self.noise)
+        if p["cmc"] != "none":
+            warp = self.camera.estimate(frame_of(obs), z)
+            t.m, t.P = warp_centres(t.m, t.P, warp, "corner_size")
+            self.pending = (warp_boxes(self.pending[0], warp), self.pending[1])
         self._births(dets)
 
         inn = gm.Innovation.of(t.m, t.P, self.noise)

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import corner_iou, lapjv
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, frame_of, register
+from .camera_motion import METHODS, CameraMotion, warp_centres
 from .kalman import KalmanBank, box_model, stop_shrinking_to_nothing
 
 
@@ -27,15 +28,24 @@ class Sort(Tracker):
         "min_hits": Param(3, "[0, inf)", "matches in a row before a track is reported (from the first frames at "
                                          "once, as the reference)", (0, 6)),
         "iou_threshold": Param(0.3, "[0, 1]", "least IoU of a match", (0.05, 0.7)),
-        "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.95))}
+        "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.95)),
+        "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper; see "
+                                      "camera_motion.py): the predictions moved with the image")}
+
+    @property
+    def needs_frame(self) -> bool:
+        return self.params["cmc"] != "none"
 
     def reset(self, info=None):
         self.tracks = SortTracks(self.params["iou_threshold"])
+        self.camera = CameraMotion(self.params["cmc"])
 
     def update(self, obs) -> Tracks:
         p, tracks = self.params, self.tracks
         dets = detections(obs)
-        tracks.advance(dets[dets[:, 4] >= p["min_confidence"]])
+        dets = dets[dets[:, 4] >= p["min_confidence"]]
+        warp = self.camera.estimate(frame_of(obs), dets[:, :4]) if self.needs_frame else None
+        tracks.advance(dets, warp)
         streak, misses = tracks.counts[:, 0], tracks.counts[:, 3]
         report = (misses < 1) & ((streak >= p["min_hits"]) | (tracks.frame <= p["min_hits"]))
         return Tracks.of(*tracks.decide(report, misses <= p["max_age"]))
@@ -65,13 +75,16 @@ class SortTracks:
         self.kf.keep(mask)
         self.ids, self.counts, self.last = self.ids[mask], self.counts[mask], self.last[mask]
 
-    def advance(self, dets: np.ndarray) -> None:
-        """Move the tracks on one frame with its detections (x, y, w, h, confidence), as SORT does."""
+    def advance(self, dets: np.ndarray, warp: np.ndarray | None = None) -> None:
+        """Move the tracks on one frame with its detections (x, y, w, h, confidence), as SORT does; a camera-motion
+        `warp` (2x3, camera_motion.py) moves the predictions before they are matched."""
         corners = dets[:, :4].copy()
         corners[:, 2:] += corners[:, :2]
         self.frame += 1
         stop_shrinking_to_nothing(self.kf)
         self.kf.predict()
+        if warp is not None:
+            self.kf.x, self.kf.P = warp_centres(self.kf.x, self.kf.P, warp, "centre_area")
         self.counts[self.counts[:, 3] > 0, 0] = 0   # a streak ends with a miss
         self.counts[:, 2:] += 1                     # age, misses
         predicted = state_to_corners(self.kf.x)

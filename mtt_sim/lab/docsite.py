@@ -30,7 +30,8 @@ DOCS = ROOT / "docs"  # the site's pages, images and notebooks
 # stand for the generated pages, one per scenario and per tracker, after the section's overview page.
 NAV = [("Home", "index.md"),
        ("The Gym loop", "gym.md"),
-       ("Trackers", [("Trackers", "trackers.md"), ("One page each", "trackers/")]),
+       ("Trackers", [("Trackers", "trackers.md"), ("One page each", "trackers/"),
+                     ("Peers: Roboflow's trackers", "peers.md")]),
        ("Scenarios", [("Scenarios", "scenarios.md"), ("One page each", "scenarios/")]),
        ("Metrics", "metrics.md"),
        ("Configuration", "config.md"),
