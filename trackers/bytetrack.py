@@ -58,27 +58,37 @@ class ByteTrack(Tracker):
         pool = _joint([r for r in self.tracked if self.activated[r]], self.lost)
         self._predict(pool)
         activated, refound, lost_now, removed_now = [], [], [], []
+        # every IoU the three rounds read: a round's tracks are not corrected before it (unconfirmed ones never move)
+        iou = plus_one_iou(corners(self._tlwh(pool + unconfirmed)), corners(tlwh))
+        n = len(pool)
 
         # first association: tracked and lost tracks with the high detections
-        matches, left_tracks, left_high = self._associate(pool, tlwh[high], score[high], p["match_thresh"])
-        for t, _ in matches:
-            (activated if self.state[pool[t]] == TRACKED else refound).append(pool[t])
-        self._correct([pool[t] for t in matches[:, 0]], high[matches[:, 1]], tlwh, score)
+        matches, left_tracks, left_high = self._associate(iou[:n][:, high], score[high], p["match_thresh"])
+        matched = [pool[t] for t in matches[:, 0].tolist()]
+        for r in matched:
+            (activated if self.state[r] == TRACKED else refound).append(r)
+        corrected, by = [matched], [high[matches[:, 1]]]  # corrected together at the end: no round reads another's
         # second association: tracked tracks left with the low detections
-        rest = [pool[t] for t in left_tracks if self.state[pool[t]] == TRACKED]
-        matches, still, _ = self._associate(rest, tlwh[low], None, 0.5)
-        activated += [rest[t] for t in matches[:, 0]]
-        self._correct([rest[t] for t in matches[:, 0]], low[matches[:, 1]], tlwh, score)
-        for t in still:
+        rest_at = [t for t in left_tracks.tolist() if self.state[pool[t]] == TRACKED]
+        rest = [pool[t] for t in rest_at]
+        matches, still, _ = self._associate(iou[np.ix_(rest_at, low)], None, 0.5)
+        matched = [rest[t] for t in matches[:, 0].tolist()]
+        activated += matched
+        corrected.append(matched)
+        by.append(low[matches[:, 1]])
+        for t in still.tolist():
             if self.state[rest[t]] != LOST:
                 self.state[rest[t]] = LOST
                 lost_now.append(rest[t])
         # tracks born last frame with the high detections left
         high = high[left_high]
-        matches, left_new, left_high = self._associate(unconfirmed, tlwh[high], score[high], 0.7)
-        activated += [unconfirmed[t] for t in matches[:, 0]]
-        self._correct([unconfirmed[t] for t in matches[:, 0]], high[matches[:, 1]], tlwh, score)
-        for t in left_new:
+        matches, left_new, left_high = self._associate(iou[n:][:, high], score[high], 0.7)
+        matched = [unconfirmed[t] for t in matches[:, 0].tolist()]
+        activated += matched
+        corrected.append(matched)
+        by.append(high[matches[:, 1]])
+        self._correct(sum(corrected, []), np.concatenate(by), tlwh, score)
+        for t in left_new.tolist():
             self.state[unconfirmed[t]] = REMOVED
             removed_now.append(unconfirmed[t])
         # new tracks
@@ -104,13 +114,13 @@ class ByteTrack(Tracker):
             mean[self.state[rows] != TRACKED, 7] = 0
             self.mean[rows], self.cov[rows] = xyah_predict(mean, self.cov[rows])
 
-    def _associate(self, rows: list[int], tlwh: np.ndarray, score: np.ndarray | None, limit: float):
-        """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks
-        `rows` and detections by 1 - IoU (times the score unless mot20 or `score` is None), capped at `limit`."""
-        if not rows or not len(tlwh):
-            return np.zeros((0, 2), np.intp), np.arange(len(rows)), np.arange(len(tlwh))
-        cost = 1 - plus_one_iou(corners(self._tlwh(rows)), corners(tlwh))
-        if score is not None and not self.params["mot20"] and cost.size:
+    def _associate(self, iou: np.ndarray, score: np.ndarray | None, limit: float):
+        """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks and
+        detections by their `iou`: cost 1 - IoU (times the score unless mot20 or `score` is None), capped at `limit`."""
+        if not iou.size:
+            return np.zeros((0, 2), np.intp), np.arange(iou.shape[0]), np.arange(iou.shape[1])
+        cost = 1 - iou
+        if score is not None and not self.params["mot20"]:
             cost = 1 - (1 - cost) * score[None, :]
         return lapjv(cost, limit)
 
@@ -141,7 +151,8 @@ class ByteTrack(Tracker):
     def _rearrange(self, activated, refound, lost_now, removed_now) -> None:
         """The reference's list bookkeeping at the end of a frame, in its order (ids and duplicates depend on it)."""
         tracked = _joint(_joint([r for r in self.tracked if self.state[r] == TRACKED], activated), refound)
-        lost = [r for r in self.lost if r not in set(tracked)] + lost_now
+        in_tracked = set(tracked)
+        lost = [r for r in self.lost if r not in in_tracked] + lost_now
         lost = [r for r in lost if int(self.ids[r]) not in self.removed_ids]
         self.removed_ids.update(int(self.ids[r]) for r in removed_now)
         self.tracked, self.lost = self._without_duplicates(tracked, lost)
@@ -173,7 +184,8 @@ class ByteTrack(Tracker):
 
 def _joint(a: list[int], b: list[int]) -> list[int]:
     """The reference's joint_stracks: the rows of `a`, then those of `b` not in `a`."""
-    return a + [r for r in dict.fromkeys(b) if r not in set(a)]
+    seen = set(a)
+    return a + [r for r in dict.fromkeys(b) if r not in seen]
 
 
 def xyah_to_tlwh(m: np.ndarray) -> np.ndarray:
