@@ -17,7 +17,7 @@ import numpy as np
 from .assignment import corner_iou, corners, lapjv, plus_one_iou
 from .bytetrack import tlwh_to_xyah, xyah_to_tlwh
 from .kalman import xyah_initiate, xyah_predict, xyah_update
-from .sort import SortTracks, paired_iou
+from .sort import CountedTracks, SortTracks, paired_iou
 
 BASES = ("sort", "bytetrack")
 
@@ -49,7 +49,7 @@ SORT_RULES[0, [FEATURES.index("matched"), FEATURES.index("streak"), FEATURES.ind
 SORT_RULES[1, [FEATURES.index("misses"), -1]] = -10, 1.5
 
 
-class ByteTracks:
+class ByteTracks(CountedTracks):
     """ByteTrack's association without its decisions, with SortTracks' interface: every frame the tracks predict with
     ByteTrack's filter (height velocity held where a track was missed), take the detections over track_thresh (cost
     1 - IoU x confidence, at most match_thresh); those matched last frame and not now take the detections between
@@ -58,19 +58,12 @@ class ByteTracks:
     `decide`. IoU counts pixels inclusively, as ByteTrack's."""
 
     def __init__(self, track_thresh: float = 0.5, match_thresh: float = 0.8, capacity: int | None = None):
-        self.track_thresh, self.match_thresh, self.capacity = track_thresh, match_thresh, capacity
+        super().__init__(capacity)
+        self.track_thresh, self.match_thresh = track_thresh, match_thresh
         self.mean, self.cov = np.zeros((0, 8)), np.zeros((0, 8, 8))
-        self.ids = np.zeros(0, np.int64)
-        self.counts = np.zeros((0, 4), np.int64)   # streak, hits, age, misses
-        self.last = np.zeros((0, 2))                # confidence, match IoU of the last matched detection
-        self.next_id, self.frame = 1, 0
 
-    def __len__(self) -> int:
-        return len(self.ids)
-
-    def _keep(self, mask: np.ndarray) -> None:
-        self.mean, self.cov, self.ids = self.mean[mask], self.cov[mask], self.ids[mask]
-        self.counts, self.last = self.counts[mask], self.last[mask]
+    def _keep_filters(self, mask: np.ndarray) -> None:
+        self.mean, self.cov = self.mean[mask], self.cov[mask]
 
     def advance(self, dets: np.ndarray) -> None:
         """Move the tracks on one frame with its detections (x, y, w, h, confidence)."""
@@ -82,8 +75,7 @@ class ByteTracks:
         mean = self.mean.copy()
         mean[~was_tracked, 7] = 0.0
         self.mean, self.cov = xyah_predict(mean, self.cov)
-        self.counts[~was_tracked, 0] = 0
-        self.counts[:, 2:] += 1
+        self._age()
         predicted = corners(self.boxes())
         boxes = corners(dets[:, :4])
         iou = plus_one_iou(predicted, boxes)
@@ -94,21 +86,12 @@ class ByteTracks:
         t2, d2 = rest[second[0][:, 0]], low[second[0][:, 1]]
         t, d = np.concatenate([t1, t2]), np.concatenate([d1, d2])
         self.mean[t], self.cov[t] = xyah_update(self.mean[t], self.cov[t], tlwh_to_xyah(dets[d, :4]))
-        self.counts[t, :2] += 1
-        self.counts[t, 3] = 0
-        self.last[t, 0], self.last[t, 1] = score[d], paired_iou(predicted[t], boxes[d])
+        self._matched(t, score[d], paired_iou(predicted[t], boxes[d]))
         born = high[first[2]]
         born = born[score[born] >= self.track_thresh + 0.1]
         mean, cov = xyah_initiate(tlwh_to_xyah(dets[born, :4]))
-        n = len(born)
         self.mean, self.cov = np.concatenate([self.mean, mean]), np.concatenate([self.cov, cov])
-        self.ids = np.concatenate([self.ids, np.arange(self.next_id, self.next_id + n)])
-        self.counts = np.concatenate([self.counts, np.zeros((n, 4), np.int64)])
-        self.last = np.concatenate([self.last, np.stack([score[born], np.ones(n)], axis=1)])
-        self.next_id += n
-        if self.capacity is not None and len(self) > self.capacity:
-            order = np.argsort(self.counts[:, 3], kind="stable")
-            self._keep(np.isin(np.arange(len(self)), order[:self.capacity]))
+        self._born(score[born])
 
     def boxes(self) -> np.ndarray:
         """Every track's box (x, y, w, h) from its filter's mean (cx, cy, aspect, height)."""
@@ -118,13 +101,6 @@ class ByteTracks:
         """Per track, the area's relative change and the centre's speed in pixels, per frame."""
         m = self.mean
         return m[:, 6] / np.maximum(m[:, 2], 1e-6) + 2 * m[:, 7] / np.maximum(m[:, 3], 1e-6), np.hypot(m[:, 4], m[:, 5])
-
-    def decide(self, report: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The reported tracks' (ids, boxes), then drop those not kept."""
-        report, keep = np.asarray(report, bool), np.asarray(keep, bool)
-        out = self.ids[report], self.boxes()[report]
-        self._keep(keep)
-        return out
 
 
 class Candidates:

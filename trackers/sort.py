@@ -51,16 +51,14 @@ class Sort(Tracker):
         return Tracks.of(*tracks.decide(report, misses <= p["max_age"]))
 
 
-class SortTracks:
-    """SORT's tracks without its two decisions: `advance(dets)` predicts, associates and starts tracks from a frame's
-    detections as the reference does, keeping per track its streak, hits, age and misses and its last matched
-    detection's confidence and IoU with the prediction; `decide(report, keep)` returns the reported tracks and drops
-    those not kept. SORT decides by min_hits and max_age; `management.Candidates` hands the decisions to a policy.
-    With a `capacity`, the tracks missed longest are dropped first beyond it."""
+class CountedTracks:
+    """What a tracker's tracks keep beside their filters when a rule or a policy makes its decisions: per track an
+    id, its counts (streak, hits, age, misses) and its last matched detection's confidence and IoU with the
+    prediction; `decide(report, keep)` returns the reported tracks and drops those not kept. With a `capacity`, the
+    tracks missed longest are dropped first beyond it. Subclasses hold the filters (`_keep_filters`, `boxes`)."""
 
-    def __init__(self, iou_threshold: float = 0.3, capacity: int | None = None):
-        self.iou_threshold, self.capacity = iou_threshold, capacity
-        self.kf = KalmanBank(box_model())
+    def __init__(self, capacity: int | None = None):
+        self.capacity = capacity
         self.ids = np.zeros(0, np.int64)
         self.counts = np.zeros((0, 4), np.int64)   # streak, hits, age, misses
         self.last = np.zeros((0, 2))                # confidence, match IoU of the last matched detection
@@ -72,8 +70,51 @@ class SortTracks:
     def _keep(self, mask: np.ndarray) -> None:
         if mask.all():
             return
-        self.kf.keep(mask)
+        self._keep_filters(mask)
         self.ids, self.counts, self.last = self.ids[mask], self.counts[mask], self.last[mask]
+
+    def _age(self) -> None:
+        """A new frame: a streak ends with a miss; ages and misses grow."""
+        self.counts[self.counts[:, 3] > 0, 0] = 0
+        self.counts[:, 2:] += 1
+
+    def _matched(self, t: np.ndarray, confidence: np.ndarray, iou: np.ndarray) -> None:
+        self.counts[t, 0] += 1
+        self.counts[t, 1] += 1
+        self.counts[t, 3] = 0
+        self.last[t, 0], self.last[t, 1] = confidence, iou
+
+    def _born(self, confidence: np.ndarray) -> None:
+        """Tracks just appended to the filters, from detections of these confidences; then the capacity."""
+        n = len(confidence)
+        self.ids = np.concatenate([self.ids, np.arange(self.next_id, self.next_id + n)])
+        self.counts = np.concatenate([self.counts, np.zeros((n, 4), np.int64)])
+        self.last = np.concatenate([self.last, np.stack([confidence, np.ones(n)], axis=1)])
+        self.next_id += n
+        if self.capacity is not None and len(self) > self.capacity:
+            order = np.argsort(self.counts[:, 3], kind="stable")
+            self._keep(np.isin(np.arange(len(self)), order[:self.capacity]))
+
+    def decide(self, report: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The reported tracks' (ids, boxes), then drop those not kept."""
+        report, keep = np.asarray(report, bool), np.asarray(keep, bool)
+        out = self.ids[report], self.boxes()[report]
+        self._keep(keep)
+        return out
+
+
+class SortTracks(CountedTracks):
+    """SORT's tracks without its two decisions: `advance(dets)` predicts, associates and starts tracks from a frame's
+    detections as the reference does. SORT decides by min_hits and max_age; `management.Candidates` hands the
+    decisions to a policy."""
+
+    def __init__(self, iou_threshold: float = 0.3, capacity: int | None = None):
+        super().__init__(capacity)
+        self.iou_threshold = iou_threshold
+        self.kf = KalmanBank(box_model())
+
+    def _keep_filters(self, mask: np.ndarray) -> None:
+        self.kf.keep(mask)
 
     def advance(self, dets: np.ndarray, warp: np.ndarray | None = None) -> None:
         """Move the tracks on one frame with its detections (x, y, w, h, confidence), as SORT does; a camera-motion
@@ -85,8 +126,7 @@ class SortTracks:
         self.kf.predict()
         if warp is not None:
             self.kf.x, self.kf.P = warp_centres(self.kf.x, self.kf.P, warp, "centre_area")
-        self.counts[self.counts[:, 3] > 0, 0] = 0   # a streak ends with a miss
-        self.counts[:, 2:] += 1                     # age, misses
+        self._age()
         predicted = state_to_corners(self.kf.x)
         defined = ~np.isnan(predicted).any(axis=1)
         self._keep(defined)
@@ -94,18 +134,9 @@ class SortTracks:
         matched, new, _ = associate(corners, predicted, self.iou_threshold)
         d, t = matched[:, 0], matched[:, 1]
         self.kf.update(t, corners_to_measurement(corners[d]))
-        self.counts[t, 0] += 1
-        self.counts[t, 1] += 1
-        self.counts[t, 3] = 0
-        self.last[t, 0], self.last[t, 1] = dets[d, 4], paired_iou(corners[d], predicted[t])
+        self._matched(t, dets[d, 4], paired_iou(corners[d], predicted[t]))
         self.kf.add(corners_to_measurement(corners[new]))
-        self.ids = np.concatenate([self.ids, np.arange(self.next_id, self.next_id + len(new))])
-        self.counts = np.concatenate([self.counts, np.zeros((len(new), 4), np.int64)])
-        self.last = np.concatenate([self.last, np.stack([dets[new, 4], np.ones(len(new))], axis=1)])
-        self.next_id += len(new)
-        if self.capacity is not None and len(self) > self.capacity:
-            order = np.argsort(self.counts[:, 3], kind="stable")
-            self._keep(np.isin(np.arange(len(self)), order[:self.capacity]))
+        self._born(dets[new, 4])
 
     def boxes(self) -> np.ndarray:
         """Every candidate's box (x, y, w, h) from its filter's state."""
@@ -117,13 +148,6 @@ class SortTracks:
         """Per track, the area's relative change and the centre's speed in pixels, per frame."""
         x = self.kf.x
         return x[:, 6] / np.maximum(x[:, 2], 1e-6), np.hypot(x[:, 4], x[:, 5])
-
-    def decide(self, report: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The reported candidates' (ids, boxes), then drop those not kept."""
-        report, keep = np.asarray(report, bool), np.asarray(keep, bool)
-        out = self.ids[report], self.boxes()[report]
-        self._keep(keep)
-        return out
 
 
 def paired_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:

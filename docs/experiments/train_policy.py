@@ -31,6 +31,7 @@ def main() -> None:
     p.add_argument("--generations", type=int, default=15)
     p.add_argument("--population", type=int, default=12)
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--base", default="sort", help="the candidates' base tracker: sort (the shipped policy) or bytetrack")
     args = p.parse_args()
     out = Path(args.out)
     start = time.perf_counter()
@@ -42,9 +43,9 @@ def main() -> None:
                  for e in replays([str(Path(args.data) / "mot17" / name)], [1000], out / f"twin-{name}",
                                   {"sensor.model": "synthetic", "sensor.preset": preset}, args.frames)]
     learning = learn_policy(episodes, generations=args.generations, population=args.population,
-                            workers=args.workers, progress=True)
+                            workers=args.workers, progress=True, base=args.base)
     minutes = (time.perf_counter() - start) / 60
-    save_policy(out / "policy_sort.npz", learning.weights,
+    save_policy(out / f"policy_{args.base}.npz", learning.weights, base=args.base,
                 trained_on="mot17_like with the frcnn, dpm and sdp presets (seeds 1000-1001, 200 frames); twins of "
                            "MOT17-02 (dpm) and MOT17-09 (frcnn), 200 frames",
                 method=f"CMA-ES from SORT's rules, {args.generations} generations of {args.population}, seed 0, "
