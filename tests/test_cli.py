@@ -344,7 +344,12 @@ def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
             monkeypatch.setattr(perf, name, lambda measured: f"table of {measured}")
     assert cli.main(["perf", "--repeats", "1"]) == 0
     captured = capsys.readouterr()
-    assert captured.out.count("table of measure") == 10 and "measuring" in captured.err
+    assert captured.out.count("table of measure") == 11 and "measuring" in captured.err
+    assert cli.main(["perf", "--repeats", "1", "--sections", "baselines,jpda"]) == 0
+    assert capsys.readouterr().out.split() == ["table", "of", "measure_jpda", "table", "of", "measure_baselines"]
+    with pytest.raises(SystemExit):
+        cli.main(["perf", "--sections", "speed"])
+    assert "'speed': sections are env, scenarios" in capsys.readouterr().err
 
 
 def test_docs_builds_a_page_per_scenario_and_per_tracker(tmp_path, capsys):
