@@ -116,7 +116,7 @@ def test_registry_and_parameters():
     assert set(BASELINES) <= set(trackers.available())
     assert all(trackers.available()[n] for n in BASELINES)
     t = trackers.make("sort:max_age=4,min_hits=1", iou_threshold=0.2)
-    assert t.params == {"max_age": 4, "min_hits": 1, "iou_threshold": 0.2, "min_confidence": 0.0}
+    assert t.params == {"max_age": 4, "min_hits": 1, "iou_threshold": 0.2, "min_confidence": 0.0, "cmc": "none"}
     with pytest.raises(ValueError, match=r"unknown tracker 'deepsort' \(did you mean 'sort'\?\); available: "
                                          + ", ".join(sorted(trackers.available()))):
         trackers.make("deepsort")
