@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import corners, lapjv, plus_one_iou
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections, frame_of, register
+from .camera_motion import METHODS, CameraMotion, warp_centres
 from .kalman import xyah_initiate, xyah_predict, xyah_update
 
 TRACKED, LOST, REMOVED = 1, 2, 3  # the reference's TrackState (New = 0 is never stored)
@@ -32,9 +33,16 @@ class ByteTrack(Tracker):
         "track_buffer": Param(30, "[0, inf)", "frames a lost track is kept (at 30 frames/s)", (1, 120, "log")),
         "match_thresh": Param(0.8, "[0, 1]", "largest cost (1 - IoU x score) of a first-round match", (0.5, 0.99)),
         "mot20": Param(False, None, "the reference's MOT20 switch: no score fusion in the first round"),
-        "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)")}
+        "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)"),
+        "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper, as BoT-SORT; see "
+                                      "camera_motion.py): tracked, lost and new tracks moved with the image")}
+
+    @property
+    def needs_frame(self) -> bool:
+        return self.params["cmc"] != "none"
 
     def reset(self, info=None):
+        self.camera = CameraMotion(self.params["cmc"])
         self.mean, self.cov = np.zeros((0, 8)), np.zeros((0, 8, 8))
         self.ids, self.state = np.zeros(0, np.int64), np.zeros(0, np.int8)
         self.activated = np.zeros(0, bool)
@@ -57,6 +65,11 @@ class ByteTrack(Tracker):
         unconfirmed = [r for r in self.tracked if not self.activated[r]]
         pool = _joint([r for r in self.tracked if self.activated[r]], self.lost)
         self._predict(pool)
+        if self.needs_frame:
+            moved = pool + unconfirmed
+            warp = self.camera.estimate(frame_of(obs), tlwh)
+            self.mean[moved], self.cov[moved] = warp_centres(self.mean[moved], self.cov[moved], warp,
+                                                             "centre_aspect_height")
         activated, refound, lost_now, removed_now = [], [], [], []
         # every IoU the three rounds read: a round's tracks are not corrected before it (unconfirmed ones never move)
         iou = plus_one_iou(corners(self._tlwh(pool + unconfirmed)), corners(tlwh))

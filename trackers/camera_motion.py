@@ -75,9 +75,10 @@ class CameraMotion:
 
 def warp_centres(x: np.ndarray, P: np.ndarray, A: np.ndarray, layout: str) -> tuple[np.ndarray, np.ndarray]:
     """Kalman states x (n, d) and covariances P (n, d, d) moved by the 2x3 warp A. `layout` says where the box is:
-    "centre_area" (SORT's cx, cy, s, r, vcx, vcy, vs: the centre moves, the area scales by det A) or
-    "corner_size" (LMB's x, y, w, h, vx, vy, vw, vh: the centre moves, the size scales by sqrt(det A)); velocities
-    turn and scale with the warp's linear part."""
+    "centre_area" (SORT's cx, cy, s, r, vcx, vcy, vs: the centre moves, the area scales by det A),
+    "corner_size" (LMB's x, y, w, h, vx, vy, vw, vh: the centre moves, the size scales by sqrt(det A)) or
+    "centre_aspect_height" (ByteTrack's cx, cy, a, h, vcx, vcy, va, vh: the centre moves, the height scales by
+    sqrt(det A)); velocities turn and scale with the warp's linear part."""
     if np.array_equal(A, IDENTITY) or not len(x):
         return x, P
     L, t = A[:, :2], A[:, 2]
@@ -100,8 +101,14 @@ def warp_centres(x: np.ndarray, P: np.ndarray, A: np.ndarray, layout: str) -> tu
         T[:2, :2] = T[4:6, 4:6] = L
         T[:2, 2:4] = (L - s * np.eye(2)) / 2  # the corner moves with the centre, less half the size's change
         T[2, 2] = T[3, 3] = T[6, 6] = T[7, 7] = s
+    elif layout == "centre_aspect_height":
+        x[:, :2] = x[:, :2] @ L.T + t
+        x[:, 4:6] = x[:, 4:6] @ L.T
+        x[:, [3, 7]] *= s
+        T[:2, :2] = T[4:6, 4:6] = L
+        T[3, 3] = T[7, 7] = s
     else:
-        raise ValueError(f"layout={layout!r}: allowed: 'centre_area', 'corner_size'")
+        raise ValueError(f"layout={layout!r}: allowed: 'centre_area', 'corner_size', 'centre_aspect_height'")
     return x, T @ P @ T.T
 
 
