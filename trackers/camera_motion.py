@@ -30,7 +30,7 @@ class CameraMotion:
         self.last: np.ndarray | None = None
         self.last_boxes = np.zeros((0, 4))
 
-    def estimate(self, frame: np.ndarray | None, boxes: np.ndarray = np.zeros((0, 4))) -> np.ndarray:
+    def estimate(self, frame: np.ndarray | None, boxes: np.ndarray | None = None) -> np.ndarray:
         """The 2x3 warp from the last frame to `frame` (RGB, (H, W, 3) uint8); `boxes` (x, y, w, h) are this
         frame's detections, whose pixels the next estimate does not follow. The first frame gives the identity."""
         if self.method == "none":
@@ -45,7 +45,7 @@ class CameraMotion:
             if found is not None:
                 warp = found
                 warp[:, 2] *= self.downscale
-        self.last, self.last_boxes = grey, np.asarray(boxes, float).reshape(-1, 4)
+        self.last, self.last_boxes = grey, np.zeros((0, 4)) if boxes is None else np.asarray(boxes, float).reshape(-1, 4)
         return warp
 
     def _sparse_flow(self, last: np.ndarray, grey: np.ndarray) -> np.ndarray | None:
