@@ -27,12 +27,14 @@ def corner_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def plus_one_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """IoU (len(a), len(b)) of boxes x1, y1, x2, y2 counting pixels inclusively (a box from 0 to 9 is 10 wide), as
     cython_bbox's bbox_overlaps computes it for ByteTrack."""
-    iw = np.minimum(a[:, None, 2], b[:, 2]) - np.maximum(a[:, None, 0], b[:, 0]) + 1
-    ih = np.minimum(a[:, None, 3], b[:, 3]) - np.maximum(a[:, None, 1], b[:, 1]) + 1
-    area_a, area_b = (a[:, 2] - a[:, 0] + 1) * (a[:, 3] - a[:, 1] + 1), (b[:, 2] - b[:, 0] + 1) * (b[:, 3] - b[:, 1] + 1)
+    ax1, ay1, ax2, ay2 = a.T[:, :, None]
+    bx1, by1, bx2, by2 = b.T
+    iw = np.minimum(ax2, bx2) - np.maximum(ax1, bx1) + 1
+    ih = np.minimum(ay2, by2) - np.maximum(ay1, by1) + 1
     inter = iw * ih
-    out = np.zeros(inter.shape)
-    return np.divide(inter, area_a[:, None] + area_b - inter, out=out, where=(iw > 0) & (ih > 0))
+    overlap = (iw > 0) & (ih > 0)
+    union = (ax2 - ax1 + 1) * (ay2 - ay1 + 1) + (bx2 - bx1 + 1) * (by2 - by1 + 1) - inter
+    return np.where(overlap, inter / np.where(overlap, union, 1.0), 0.0)
 
 
 def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -43,9 +45,12 @@ def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarr
     n, m = cost.shape
     if not cost.size:
         return np.zeros((0, 2), np.intp), np.arange(n), np.arange(m)
-    _, x, y = lap.lapjv(cost, extend_cost=True, **({} if np.isinf(limit) else {"cost_limit": limit}))
-    rows = np.flatnonzero(x >= 0)
-    return np.stack([rows, x[rows]], axis=1), np.flatnonzero(x < 0), np.flatnonzero(y < 0)
+    x, y = lap.lapjv(cost, extend_cost=True, return_cost=False, **({} if np.isinf(limit) else {"cost_limit": limit}))
+    matched = x >= 0
+    rows = matched.nonzero()[0]
+    pairs = np.empty((len(rows), 2), np.intp)
+    pairs[:, 0], pairs[:, 1] = rows, x[matched]
+    return pairs, (~matched).nonzero()[0], (y < 0).nonzero()[0]
 
 
 def chi2_gate(dim: int, probability: float = 0.99) -> float:

@@ -78,13 +78,13 @@ def detections(obs: Mapping) -> np.ndarray:
         raise ValueError(f"observation 'num_detections' = {obs['num_detections']!r}: must be an integer in "
                          f"0..{len(rows)} (the rows of 'detections')")
     rows = rows[: int(count)]
-    bad = ~np.isfinite(rows).all(axis=1)
-    if bad.any():
-        raise ValueError(f"observation detection row {int(np.flatnonzero(bad)[0])} is not finite")
-    small = (rows[:, 2] <= 0) | (rows[:, 3] <= 0)
-    if small.any():
-        raise ValueError(f"observation detection row {int(np.flatnonzero(small)[0])} has a non-positive width or "
-                         f"height: {rows[small][0].tolist()} (boxes are x, y, w, h)")
+    if not np.isfinite(rows).all():
+        row = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
+        raise ValueError(f"observation detection row {row} is not finite")
+    if not (rows[:, 2:4] > 0).all():
+        row = int(np.flatnonzero((rows[:, 2:4] <= 0).any(axis=1))[0])
+        raise ValueError(f"observation detection row {row} has a non-positive width or height: {rows[row].tolist()} "
+                         "(boxes are x, y, w, h)")
     return rows
 
 

@@ -72,7 +72,7 @@ class ByteTrack(Tracker):
                                                              "centre_aspect_height")
         activated, refound, lost_now, removed_now = [], [], [], []
         # every IoU the three rounds read: a round's tracks are not corrected before it (unconfirmed ones never move)
-        iou = plus_one_iou(corners(self._tlwh(pool + unconfirmed)), corners(tlwh))
+        iou = plus_one_iou(xyah_to_corners(self.mean[pool + unconfirmed]), corners(tlwh))
         n = len(pool)
 
         # first association: tracked and lost tracks with the high detections
@@ -84,7 +84,7 @@ class ByteTrack(Tracker):
         # second association: tracked tracks left with the low detections
         rest_at = [t for t in left_tracks.tolist() if self.state[pool[t]] == TRACKED]
         rest = [pool[t] for t in rest_at]
-        matches, still, _ = self._associate(iou[np.ix_(rest_at, low)], None, 0.5)
+        matches, still, _ = self._associate(iou[rest_at][:, low], None, 0.5)
         matched = [rest[t] for t in matches[:, 0].tolist()]
         activated += matched
         corrected.append(matched)
@@ -109,8 +109,9 @@ class ByteTrack(Tracker):
         born = born[score[born] >= p["track_thresh"] + 0.1]
         activated += self._start(tlwh[born], score[born])
         # lost too long
+        patience = int(p["frame_rate"] / 30.0 * p["track_buffer"])
         for r in self.lost:
-            if self.frame - self.last_frame[r] > int(p["frame_rate"] / 30.0 * p["track_buffer"]):
+            if self.frame - self.last_frame[r] > patience:
                 self.state[r] = REMOVED
                 removed_now.append(r)
         self._rearrange(activated, refound, lost_now, removed_now)
@@ -123,7 +124,7 @@ class ByteTrack(Tracker):
 
     def _predict(self, rows: list[int]) -> None:
         if rows:
-            mean = self.mean[rows].copy()
+            mean = self.mean[rows]
             mean[self.state[rows] != TRACKED, 7] = 0
             self.mean[rows], self.cov[rows] = xyah_predict(mean, self.cov[rows])
 
@@ -175,8 +176,8 @@ class ByteTrack(Tracker):
         """A tracked and a lost track with 1 - IoU < 0.15: the one that has been tracked for fewer frames goes."""
         if not tracked or not lost:
             return tracked, lost
-        a, b = self._tlwh(tracked), self._tlwh(lost)
-        close = np.argwhere(1 - plus_one_iou(corners(a), corners(b)) < 0.15)
+        boxes = xyah_to_corners(self.mean[tracked + lost])
+        close = np.argwhere(1 - plus_one_iou(boxes[:len(tracked)], boxes[len(tracked):]) < 0.15)
         age = self.last_frame - self.start_frame
         drop_a = {p for p, q in close if not age[tracked[p]] > age[lost[q]]}
         drop_b = {q for p, q in close if age[tracked[p]] > age[lost[q]]}
@@ -208,6 +209,17 @@ def xyah_to_tlwh(m: np.ndarray) -> np.ndarray:
     out[:, 0] = m[:, 0] - out[:, 2] / 2
     out[:, 1] = m[:, 1] - m[:, 3] / 2
     out[:, 3] = m[:, 3]
+    return out
+
+
+def xyah_to_corners(m: np.ndarray) -> np.ndarray:
+    """Filter means (cx, cy, aspect, height, ...) -> boxes x1, y1, x2, y2 (as corners(xyah_to_tlwh(m)), in one go)."""
+    out = np.empty((len(m), 4))
+    width = m[:, 2] * m[:, 3]
+    out[:, 0] = m[:, 0] - width / 2
+    out[:, 1] = m[:, 1] - m[:, 3] / 2
+    out[:, 2] = out[:, 0] + width
+    out[:, 3] = out[:, 1] + m[:, 3]
     return out
 
 

@@ -52,37 +52,51 @@ def stop_shrinking_to_nothing(bank: "KalmanBank") -> None:
 
 # ByteTrack's filter (DeepSORT's): state (cx, cy, aspect, height) and their velocities, noise proportional to the height
 _POSITION, _VELOCITY = 1 / 20, 1 / 160
-_F8, _H8 = np.eye(8) + np.eye(8, k=4), np.eye(4, 8)
+_F8 = np.eye(8) + np.eye(8, k=4)
+_DIAG8, _DIAG4 = np.arange(8), np.arange(4)
 
 
-def _variances(height: np.ndarray, weights: list[float], fixed: dict[int, float]) -> np.ndarray:
-    """(n, d, d) diagonal covariances: standard deviation weight x height per entry, except the `fixed` entries."""
-    std = np.outer(height, weights)
-    for i, value in fixed.items():
-        std[:, i] = value
-    out = np.zeros(std.shape + std.shape[-1:])
-    idx = np.arange(std.shape[1])
-    out[:, idx, idx] = std**2
-    return out
+def _noise_rule(weights: list[float], fixed: dict[int, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A diagonal noise: standard deviation weight x height per entry, except the `fixed` entries; as (weights,
+    which entries are fixed, their variances), worked out once for _variances."""
+    is_fixed = np.isin(np.arange(len(weights)), list(fixed))
+    values = np.zeros(len(weights))
+    values[list(fixed)] = list(fixed.values())
+    return np.array(weights), is_fixed, np.square(values)
+
+
+_INITIAL = _noise_rule([2 * _POSITION] * 4 + [10 * _VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
+_PROCESS = _noise_rule([_POSITION] * 4 + [_VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
+_MEASUREMENT = _noise_rule([_POSITION] * 4, {2: 1e-1})
+
+
+def _variances(height: np.ndarray, rule: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+    """(n, d) variances of a _noise_rule for tracks of these heights."""
+    weights, is_fixed, fixed = rule
+    return np.where(is_fixed, fixed, np.square(height[:, None] * weights))
 
 
 def xyah_initiate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """New tracks at measurements z (n, 4) cx, cy, aspect, height: means (n, 8) and covariances (n, 8, 8)."""
-    cov = _variances(z[:, 3], [2 * _POSITION] * 4 + [10 * _VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
+    cov = np.zeros((len(z), 8, 8))
+    cov[:, _DIAG8, _DIAG8] = _variances(z[:, 3], _INITIAL)
     return np.concatenate([z, np.zeros_like(z)], axis=1), cov
 
 
 def xyah_predict(mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """One constant-velocity step, with process noise scaled by each track's height."""
-    noise = _variances(mean[:, 3], [_POSITION] * 4 + [_VELOCITY] * 4, {2: 1e-2, 6: 1e-5})
-    return mean @ _F8.T, _F8 @ cov @ _F8.T + noise
+    cov = _F8 @ cov @ _F8.T
+    cov[:, _DIAG8, _DIAG8] += _variances(mean[:, 3], _PROCESS)
+    return mean @ _F8.T, cov
 
 
 def xyah_update(mean: np.ndarray, cov: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Correct with measurements z (n, 4), measurement noise scaled by the predicted height."""
-    S = _H8 @ cov @ _H8.T + _variances(mean[:, 3], [_POSITION] * 4, {2: 1e-1})
-    K = np.linalg.solve(S, _H8 @ cov).transpose(0, 2, 1)  # P H^T S^-1
-    innovation = z - mean @ _H8.T
+    """Correct with measurements z (n, 4), measurement noise scaled by the predicted height. H selects the first four
+    entries, so H P H^T, P H^T and H x are slices."""
+    S = cov[:, :4, :4].copy()
+    S[:, _DIAG4, _DIAG4] += _variances(mean[:, 3], _MEASUREMENT)
+    K = np.linalg.solve(S, cov[:, :4, :]).transpose(0, 2, 1)  # P H^T S^-1
+    innovation = z - mean[:, :4]
     return mean + np.einsum("nij,nj->ni", K, innovation), cov - K @ S @ K.transpose(0, 2, 1)
 
 
