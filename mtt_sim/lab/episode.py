@@ -32,6 +32,7 @@ class Episode:
         self.done = False
         self.tracks: Tracks | None = None
         self.action = NO_TRACKS
+        self.reward = 0.0  # the last step's
         self.tracker_time = self.env_time = 0.0
         self._answered = time.perf_counter()
 
@@ -45,7 +46,7 @@ class Episode:
 
     def advance(self) -> None:
         """Step the env with the answer; done when the episode ends or after `limit` steps."""
-        self.obs, _, terminated, truncated, _ = self.env.step(self.action)
+        self.obs, self.reward, terminated, truncated, _ = self.env.step(self.action)
         self.env_time += time.perf_counter() - self._answered
         self.steps += 1
         self.done = terminated or truncated or self.steps >= self.limit

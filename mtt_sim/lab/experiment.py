@@ -17,6 +17,7 @@ import re
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
 
+import cv2
 import numpy as np
 from scipy.special import stdtrit
 from tqdm import tqdm
@@ -54,16 +55,19 @@ def _record(run: Episode, spec: str, online: list, scenario: str, seed: int, con
 
 def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Mapping | None = None,
                  video: str | None = None, steps: int | None = None, progress: bool = False, scale: int = 1,
-                 results: str | None = None) -> list[dict]:
+                 results: str | None = None, still: str | None = None) -> list[dict]:
     """One episode of each tracker in `specs` on `scenario` (a shipped key, a .toml file or a recorded sequence's
     folder), all on the same seed and so the same world, stepped together; optionally an annotated video with one
     panel per tracker side by side (each with its own banner, frames enlarged `scale` times), a progress bar (shown
     once the episode has run for a second) and, for a single tracker, a MOTChallenge results file of its tracks
-    (`tracker.results`: the offline output of an offline method). Returns a record per tracker; its metrics are None
-    on a recorded sequence without ground truth."""
+    (`tracker.results`: the offline output of an offline method), and a still (an image file) of the frame where the
+    first tracker's step reward was lowest. Returns a record per tracker; its metrics are None on a recorded sequence
+    without ground truth."""
     if results and len(specs) != 1:
         raise ValueError("a results file takes one tracker")
-    runs = [_episode(scenario, spec, seed, config, steps, bool(video), scale) for spec in specs]
+    drawn = bool(video or still)
+    runs = [_episode(scenario, spec, seed, config, steps, drawn, scale) for spec in specs]
+    worst: tuple[float, np.ndarray] | None = None  # the first tracker's lowest step reward, and its frame
     online: list[list[trackers.Tracks]] = [[] for _ in runs]
     writer = VideoWriter(video, runs[0].env.metadata["render_fps"]) if video else None
     with tqdm(total=runs[0].limit, desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False,
@@ -74,16 +78,22 @@ def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Map
                 run.answer()
                 n = run.action["num_tracks"]
                 tracks.append(trackers.Tracks.of(run.action["ids"][:n], run.action["boxes"][:n]))
-                if writer:
+                if drawn:
                     run.env.remember_tracks(run.tracks.ids, run.tracks.boxes, run.agent.debug(), spec)
                     panels.append(run.env.render())
                 run.advance()
-            if writer:  # panels side by side, a dark gap between them
+            if drawn:  # panels side by side, a dark gap between them
                 gap = np.full((panels[0].shape[0], 4, 3), 30, np.uint8)
-                writer.write(np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1))
+                picture = np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1)
+                if writer:
+                    writer.write(picture)
+                if still and (worst is None or runs[0].reward < worst[0]):
+                    worst = (runs[0].reward, picture)
             bar.update()
     if writer:
         writer.close()
+    if worst is not None:
+        cv2.imwrite(still, cv2.cvtColor(worst[1], cv2.COLOR_RGB2BGR))
     if results:
         write_results(results, [(t.ids, t.boxes) for t in runs[0].agent.results(online[0])])
     return [_record(run, spec, tracks, scenario, seed, config) for run, spec, tracks in zip(runs, specs, online)]

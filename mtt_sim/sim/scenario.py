@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import functools
+import json
 import math
 import tomllib
 import typing
@@ -119,6 +120,30 @@ def _build(cls, raw: Mapping, where: str, prefix: str = ""):
     values = {name: _convert(raw[name], hints[name], prefix + name, fields[name].metadata, where)
               for name in fields if name in raw}
     return cls(**values)
+
+
+def setting_of(key: str) -> tuple[type, Mapping]:
+    """The type (bool, int, float or str) and metadata (doc, unit, lo, hi, choices) of the single value a dotted key
+    names, e.g. 'sensor.pd', 'groups.0.count' or 'groups.0.size.1'; a ConfigError naming the key otherwise."""
+    tp, meta, path = Scenario, {}, ""
+    for part in key.split("."):
+        if dataclasses.is_dataclass(tp):
+            fields = {f.name: f for f in dataclasses.fields(tp)}
+            if part not in fields:
+                raise ConfigError(f"{key}: no key {path}{part}; allowed: {', '.join(path + f for f in fields)}")
+            tp, meta = _hints(tp)[part], fields[part].metadata
+        elif typing.get_origin(tp) is tuple:
+            args = typing.get_args(tp)
+            if not part.isdigit() or (args[-1] is not Ellipsis and int(part) >= len(args)):
+                raise ConfigError(f"{key}: {path.rstrip('.')} is a list: expected an item's index, got {part!r}")
+            tp = args[0] if args[-1] is Ellipsis else args[int(part)]
+        else:
+            raise ConfigError(f"{key}: {path.rstrip('.')} is a single value, it has no {part!r}")
+        path += part + "."
+    if tp not in (bool, int, float, str):
+        raise ConfigError(f"{key} is a table or a list ({_describe(tp) if not dataclasses.is_dataclass(tp) else 'a table'}):"
+                          " name one of its values")
+    return tp, meta
 
 
 def _with_preset(raw: Mapping, where: str) -> dict:
@@ -364,7 +389,7 @@ def toml_scalar(value) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return f'"{value}"'
+        return json.dumps(value, ensure_ascii=False)  # JSON's string escapes are TOML's
     return str(value) if isinstance(value, int) else repr(float(value))
 
 

@@ -1,0 +1,112 @@
+"""`mtt-sim stress`: search a scenario's keys for the scenes where a tracker does worst, or loses most to another."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, UsageError, add_overrides, episode_overrides, integer,
+                                   output_folder, parse_seeds, replaced, require, scenario_key, tracker_spec)
+
+SAMPLERS = ("tpe", "cmaes", "random")
+
+
+def dimensions(text: str) -> list:
+    """--vary's comma-separated KEY=LO:HI and KEY=A|B items, each checked against the key's own range or choices."""
+    from mtt_sim.lab import stress
+    from mtt_sim.sim.config import ConfigError
+
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    try:
+        found = [stress.dimension(t) for t in items]
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    keys = [d.key for d in found]
+    if not found or len(set(keys)) != len(keys):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected distinct keys, e.g. sensor.clutter_rate=0:10,"
+                                         "groups.0.count=5:30,render.camera=static|shake")
+    return found
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("stress", help="search scenario keys for the scenes that break a tracker (Optuna): the "
+                                             "worst scenes as runnable files, stills and videos")
+    p.add_argument("spec", type=tracker_spec, help="the tracker under test, e.g. sort or 'lmb:reid=false'")
+    p.add_argument("--scenario", type=scenario_key, required=True, help="a scenario key or .toml file to vary")
+    p.add_argument("--vary", type=dimensions, required=True, metavar="KEY=LO:HI[,KEY=A|B ...]",
+                   help="the keys searched: numbers between LO and HI, or some of a key's choices (a key alone: all "
+                        "of them), within the key's own range; e.g. sensor.clutter_rate=0:10,render.camera=static|shake")
+    p.add_argument("--objective", default="-MOTA",
+                   help="what to make as large as possible: a metric of the tracker (-MOTA, IDSW, FN), or arithmetic "
+                        "over metrics, METRIC[spec] for another tracker on the same world: 'MOTA[sort] - MOTA[lmb]' "
+                        "finds where lmb loses most to sort (default -MOTA)")
+    p.add_argument("--budget", type=integer(1), default=30, help="scenes evaluated (default 30)")
+    p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1"),
+                   help="episode seeds per scene, a count, a list or a range; a scene's value is its worst seed's "
+                        "(default 1: seed 0)")
+    p.add_argument("--seed", type=integer(0), default=0, help="the sampler's seed: one seed, one search (default 0)")
+    p.add_argument("--workers", type=integer(1), default=1, help="processes running a scene's episodes (default 1)")
+    p.add_argument("--sampler", choices=SAMPLERS, default="tpe",
+                   help="tpe (multivariate TPE, the default), cmaes (CMA-ES) or random sampling")
+    p.add_argument("--against-random", action="store_true",
+                   help="also run random sampling with the same budget and seed, and plot both histories")
+    p.add_argument("--top", type=integer(1), default=5, help="worst scenes reported and written (default 5)")
+    p.add_argument("--out", help="a folder for the worst scenes (worst-<rank>.toml, .jpg, .mp4), table.md and "
+                                 "history.png (the [plot] extra)")
+    p.add_argument("--json", action="store_true", help="print the worst scenes as one JSON object")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_overrides(p, CONFIG_HELP + "; searched keys are set over them")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    require("optuna", "stress", "tune")
+    overrides = episode_overrides(args)
+    out = output_folder(args.out, args.force, "--out", "write into it") if args.out else None
+    if out:
+        require("matplotlib", "--out", "plot")
+    from mtt_sim.lab import stress
+    from mtt_sim.sim.config import ConfigError
+
+    try:
+        stress.check_bounds(args.scenario, args.vary, overrides)
+    except ConfigError as err:
+        raise UsageError("--vary", str(err)) from None
+    try:
+        stress.Objective(args.objective, args.spec)
+    except ValueError as err:
+        raise UsageError("--objective", str(err)) from None
+
+    def searched(sampler: str) -> stress.Search:
+        return stress.search(args.spec, args.scenario, args.vary, args.objective, args.budget, args.seeds,
+                             args.seed, args.workers, sampler, overrides, progress=not args.json)
+
+    found = searched(args.sampler)
+    random = searched("random") if args.against_random else None
+    if not found.scenes:
+        raise ValueError("every scene failed: " + "; ".join(sorted(set(found.failed))))
+    if out:
+        worst = stress.write(found, out, args.top, shlex.join(["mtt-sim", *sys.argv[2:]]), random)
+    else:
+        worst = [{"scenario": args.scenario, "config": found.config_of(s), "seed": s.seed, "value": s.value,
+                  "metrics": s.metrics if len(found.objective.specs) > 1 else s.metrics[args.spec]}
+                 for s in found.worst(args.top)]
+    if args.json:
+        summary = {"worst": worst, "evaluations": len(found.scenes) + len(found.failed), "failed": found.failed}
+        if random:
+            summary["random"] = {"worst_value": random.worst(1)[0].value if random.scenes else None,
+                                 "worst_so_far": random.worst_so_far()}
+        summary["worst_so_far"] = found.worst_so_far()
+        print(json.dumps(summary))
+        return 0
+    print(stress.table(found, args.top))
+    print(f"\n{args.objective}: worst {found.worst(1)[0].value:.4g} after {args.budget} scenes ({args.sampler})"
+          + (f"; random sampling's {random.worst(1)[0].value:.4g}" if random and random.scenes else ""))
+    for error in found.failed:
+        print(f"failed scene: {error}")
+    if out:
+        print(f"worst scenes: {out}/worst-<rank>.toml, .jpg, .mp4; table.md; history.png" + replaced(args.force))
+        print(f"again: mtt-sim run {worst[0]['scenario']} --tracker '{args.spec}' --seed {worst[0]['seed']}")
+    return 0
