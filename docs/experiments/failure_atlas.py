@@ -47,7 +47,7 @@ def main() -> None:
     def run(item):
         name, (tracker, scenario, objective) = item
         vary, config = SCENES[scenario]
-        command = ["mtt-sim", "stress", tracker, "--scenario", scenario, "--vary", vary, "--objective", objective,
+        command = ["mtt-sim", "stress", tracker, "--scenario", scenario, "--vary", vary, f"--objective={objective}",
                    "--budget", str(args.budget), "--top", str(args.top), "--out", str(out / name), "--force",
                    "--json", "--config", *config]
         start = time.perf_counter()

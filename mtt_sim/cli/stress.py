@@ -39,7 +39,8 @@ def add(subparsers) -> None:
                    help="the keys searched: numbers between LO and HI, or some of a key's choices (a key alone: all "
                         "of them), within the key's own range; e.g. sensor.clutter_rate=0:10,render.camera=static|shake")
     p.add_argument("--objective", default="-MOTA",
-                   help="what to make as large as possible: a metric of the tracker (-MOTA, IDSW, FN), or arithmetic "
+                   help="what to make as large as possible: a metric of the tracker (--objective=-MOTA, IDSW, FN; "
+                        "write a leading minus after '='), or arithmetic "
                         "over metrics, METRIC[spec] for another tracker on the same world: 'MOTA[sort] - MOTA[lmb]' "
                         "finds where lmb loses most to sort (default -MOTA)")
     p.add_argument("--budget", type=integer(1), default=30, help="scenes evaluated (default 30)")

@@ -93,8 +93,8 @@ class Objective:
         def placeholder(match) -> str:
             metric = names.get(match.group(1).lower())
             if metric is None:
-                raise ValueError(f"objective {text!r}: unknown metric {match.group(1)!r}; e.g. MOTA, IDF1, HOTA, IDSW, "
-                                 "FN, FP (see `mtt-sim metrics`)")
+                raise ValueError(f"objective {text!r}: unknown metric {match.group(1)!r}; allowed: "
+                                 + ", ".join(m for m in METRICS if m.isidentifier()))
             term = (metric, (match.group(2) or spec).strip())
             if term not in self.terms:
                 self.terms.append(term)
