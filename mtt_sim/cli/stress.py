@@ -87,9 +87,9 @@ def run(args) -> int:
     found = searched(args.sampler)
     random = searched("random") if args.against_random else None
     if not found.scenes:
-        raise ValueError("every scene failed: " + "; ".join(sorted(set(found.failed))))
+        raise ValueError("every scene failed: " + "; ".join(sorted({f["error"] for f in found.failed})))
     if out:
-        worst = stress.write(found, out, args.top, shlex.join(["mtt-sim", *sys.argv[2:]]), random)
+        worst = stress.write(found, out, args.top, shlex.join(["mtt-sim", *sys.argv[1:]]), random)
     else:
         worst = [{"scenario": args.scenario, "config": found.config_of(s), "seed": s.seed, "value": s.value,
                   "metrics": s.metrics if len(found.objective.specs) > 1 else s.metrics[args.spec]}
@@ -105,8 +105,8 @@ def run(args) -> int:
     print(stress.table(found, args.top))
     print(f"\n{args.objective}: worst {found.worst(1)[0].value:.4g} after {args.budget} scenes ({args.sampler})"
           + (f"; random sampling's {random.worst(1)[0].value:.4g}" if random and random.scenes else ""))
-    for error in found.failed:
-        print(f"failed scene: {error}")
+    for failure in found.failed:
+        print(f"failed scene {failure['params']}: {failure['error']}")
     if out:
         print(f"worst scenes: {out}/worst-<rank>.toml, .jpg, .mp4; table.md; history.png" + replaced(args.force))
         print(f"again: mtt-sim run {worst[0]['scenario']} --tracker '{args.spec}' --seed {worst[0]['seed']}")

@@ -61,13 +61,13 @@ def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Map
     panel per tracker side by side (each with its own banner, frames enlarged `scale` times), a progress bar (shown
     once the episode has run for a second) and, for a single tracker, a MOTChallenge results file of its tracks
     (`tracker.results`: the offline output of an offline method), and a still (an image file) of the frame where the
-    first tracker's step reward was lowest. Returns a record per tracker; its metrics are None on a recorded sequence
-    without ground truth."""
+    tracker's step reward was lowest (of several trackers: where their rewards differ most). Returns a record per
+    tracker; its metrics are None on a recorded sequence without ground truth."""
     if results and len(specs) != 1:
         raise ValueError("a results file takes one tracker")
     drawn = bool(video or still)
     runs = [_episode(scenario, spec, seed, config, steps, drawn, scale) for spec in specs]
-    worst: tuple[float, np.ndarray] | None = None  # the first tracker's lowest step reward, and its frame
+    worst: tuple[float, np.ndarray] | None = None  # the still's frame, and how bad or how split it was
     online: list[list[trackers.Tracks]] = [[] for _ in runs]
     writer = VideoWriter(video, runs[0].env.metadata["render_fps"]) if video else None
     with tqdm(total=runs[0].limit, desc=f"{','.join(specs)} on {scenario}", unit="frame", delay=1.0, leave=False,
@@ -87,13 +87,16 @@ def run_episodes(scenario: str, specs: Sequence[str], seed: int = 0, config: Map
                 picture = np.concatenate([x for panel in panels for x in (gap, panel)][1:], axis=1)
                 if writer:
                     writer.write(picture)
-                if still and (worst is None or runs[0].reward < worst[0]):
-                    worst = (runs[0].reward, picture)
+                if still:
+                    rewards = [run.reward for run in runs]
+                    badness = max(rewards) - min(rewards) if len(runs) > 1 else -rewards[0]
+                    if worst is None or badness > worst[0]:
+                        worst = (badness, picture)
             bar.update()
     if writer:
         writer.close()
     if worst is not None:
-        cv2.imwrite(still, cv2.cvtColor(worst[1], cv2.COLOR_RGB2BGR))
+        cv2.imwrite(still, cv2.cvtColor(worst[1], cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 80])
     if results:
         write_results(results, [(t.ids, t.boxes) for t in runs[0].agent.results(online[0])])
     return [_record(run, spec, tracks, scenario, seed, config) for run, spec, tracks in zip(runs, specs, online)]

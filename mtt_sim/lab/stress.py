@@ -149,7 +149,8 @@ class Scene:
 
 @dataclass
 class Search:
-    """A finished search: the scenes in trial order, and the errors of the trials that failed."""
+    """A finished search: the scenes in trial order, and those whose episode raised (a crash is a finding too):
+    their trial, searched values and error."""
 
     scenario: str
     config: dict
@@ -157,7 +158,7 @@ class Search:
     objective: Objective
     dimensions: list[Dimension]
     scenes: list[Scene] = field(default_factory=list)
-    failed: list[str] = field(default_factory=list)
+    failed: list[dict] = field(default_factory=list)
 
     def worst(self, count: int) -> list[Scene]:
         """The `count` scenes of largest value, the earliest first among equals."""
@@ -183,11 +184,11 @@ class Search:
 
 
 def sampler(name: str, seed: int, budget: int):
-    """The seeded Optuna sampler of `name`; TPE (multivariate: failures sit where keys meet) starts from a fifth of
-    the budget drawn at random."""
+    """The seeded Optuna sampler of `name`; TPE (multivariate: failures sit where keys meet) and CMA-ES start from a
+    tenth of the budget (2 to 10 scenes) drawn at random."""
     import optuna
 
-    startup = max(2, min(10, budget // 5))
+    startup = max(2, min(10, budget // 10))
     with warnings.catch_warnings():  # multivariate TPE is marked experimental
         warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
         if name == "tpe":
@@ -235,7 +236,8 @@ def search(spec: str, scenario: str, dimensions: Sequence[Dimension], objective:
 
     def record_failure(study, trial) -> None:
         if trial.state == optuna.trial.TrialState.FAIL:
-            found.failed.append(trial.user_attrs.get("error", "failed"))
+            found.failed.append({"trial": trial.number, "params": trial.params,
+                                 "error": trial.user_attrs.get("error", "failed")})
 
     processes = episode_pool(workers) if workers > 1 else None
     try:
@@ -293,8 +295,8 @@ def history_plot(runs: Mapping[str, Search], path: str | Path) -> None:
 
 def write(found: Search, out: str | Path, count: int, command: str = "", random: Search | None = None) -> list[dict]:
     """The `count` worst scenes into folder `out`, each rerun from its own file: worst-<rank>.toml (a complete
-    scenario), .mp4 (every tracker of the objective side by side) and .jpg (the frame of the searched tracker's
-    lowest step reward); then table.md and history.png (beside `random`'s, when given). Returns, worst first, each
+    scenario), .mp4 (every tracker of the objective side by side) and .jpg (the frame of the tracker's lowest step
+    reward, or where the trackers' rewards differ most); then table.md and history.png (beside `random`'s, when given). Returns, worst first, each
     scene's file, seed, value and metrics as rerun; a rerun that does not give the search's value raises."""
     from mtt_sim.lab.experiment import run_episodes
 
