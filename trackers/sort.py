@@ -170,7 +170,7 @@ def associate(dets: np.ndarray, tracks: np.ndarray, threshold: float,
     if min(iou.shape) > 0:
         above = iou > threshold
         if above.sum(1).max() == 1 and above.sum(0).max() == 1:  # each pair above the threshold is alone
-            matched = np.stack(np.nonzero(above), axis=1)
+            matched = np.argwhere(above)
         else:
             matched = lapjv(-iou if bonus is None else -(iou + bonus))[0]
     else:
@@ -192,7 +192,9 @@ def without(n: int, rows: np.ndarray) -> np.ndarray:
 def corners_to_measurement(corners: np.ndarray) -> np.ndarray:
     """x1, y1, x2, y2 -> SORT's measurement cx, cy, s (area), r (aspect w / h)."""
     w, h = corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1]
-    return np.stack([corners[:, 0] + w / 2, corners[:, 1] + h / 2, w * h, w / h], axis=1)
+    out = np.empty((len(corners), 4))
+    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = corners[:, 0] + w / 2, corners[:, 1] + h / 2, w * h, w / h
+    return out
 
 
 def state_to_corners(x: np.ndarray) -> np.ndarray:
@@ -200,4 +202,6 @@ def state_to_corners(x: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         w = np.sqrt(x[:, 2] * x[:, 3])
         h = x[:, 2] / w
-    return np.stack([x[:, 0] - w / 2, x[:, 1] - h / 2, x[:, 0] + w / 2, x[:, 1] + h / 2], axis=1)
+    out = np.empty((len(x), 4))
+    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = x[:, 0] - w / 2, x[:, 1] - h / 2, x[:, 0] + w / 2, x[:, 1] + h / 2
+    return out
