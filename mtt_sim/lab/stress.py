@@ -271,21 +271,24 @@ def table(found: Search, count: int) -> str:
     return "\n".join(lines + [f"| {' | '.join(map(cell, r))} |" for r in rows])
 
 
-def history_plot(runs: Mapping[str, Search], path: str | Path) -> None:
-    """Worst-so-far against evaluations, one line per search (e.g. the sampler and random sampling)."""
+def history_plot(curves: Mapping[str, Sequence[float | None]], title: str, objective: str, path: str | Path) -> None:
+    """Worst-so-far against scenes evaluated, one line per search (e.g. the sampler's and random sampling's)."""
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, ax = plt.subplots(figsize=(7, 4))
-    for label, run in runs.items():
-        curve = run.worst_so_far()
-        ax.plot(range(1, len(curve) + 1), [math.nan if v is None else v for v in curve], label=label, drawstyle="steps-post")
-    first = next(iter(runs.values()))
+    for label, curve in curves.items():
+        ax.plot(range(1, len(curve) + 1), [math.nan if v is None else v for v in curve], label=label,
+                drawstyle="steps-post")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("scenes evaluated")
-    ax.set_ylabel(f"worst so far: {first.objective.text}")
-    ax.set_title(f"{first.scenario}: " + ", ".join(d.text() for d in first.dimensions), fontsize=9)
+    ax.set_ylabel(f"worst so far: {objective}")
+    ax.set_title(textwrap.fill(title, 90), fontsize=9)
     ax.legend()
     ax.grid(alpha=0.3)
     fig.tight_layout()
@@ -321,10 +324,11 @@ def write(found: Search, out: str | Path, count: int, command: str = "", random:
         written.append({"scenario": str(path), "seed": scene.seed, "value": value, "params": scene.params,
                         "metrics": metrics if len(specs) > 1 else metrics[specs[0]]})
     (out / "table.md").write_text(table(found, count) + "\n")
-    runs = {found.sampler: found}
+    curves = {found.sampler: found.worst_so_far()}
     if random is not None:
-        runs["random (same budget and seed)"] = random
-    history_plot(runs, out / "history.png")
+        curves["random (same budget and seed)"] = random.worst_so_far()
+    title = f"{found.scenario}: " + ", ".join(d.text() for d in found.dimensions)
+    history_plot(curves, title, found.objective.text, out / "history.png")
     return written
 
 
