@@ -116,11 +116,7 @@ class ByteTrack(Tracker):
                 removed_now.append(r)
         self._rearrange(activated, refound, lost_now, removed_now)
         out = [r for r in self.tracked if self.activated[r]]
-        return Tracks.of(self.ids[out], self._tlwh(out), self.score[out])
-
-    def _tlwh(self, rows) -> np.ndarray:
-        """Boxes x, y, w, h of track rows, from their means (cx, cy, aspect, height)."""
-        return xyah_to_tlwh(self.mean[rows])
+        return Tracks.of(self.ids[out], xyah_to_tlwh(self.mean[out]), self.score[out])
 
     def _predict(self, rows: list[int]) -> None:
         if rows:

@@ -4,12 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import corner_iou
+from .assignment import corner_iou, corners
 from .base import Param, Tracker, Tracks, detections, register
-
-
-def _corners(boxes: np.ndarray) -> np.ndarray:
-    return np.c_[boxes[:, :2], boxes[:, :2] + boxes[:, 2:4]]
 
 
 @register
@@ -44,7 +40,7 @@ class IouTracker(Tracker):
         p = self.params
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["sigma_l"]]
-        iou = corner_iou(_corners(self.last), _corners(dets))
+        iou = corner_iou(corners(self.last), corners(dets))
         free = np.ones(len(dets), bool)
         match = np.full(len(self.key), -1)
         for r in range(len(self.key)):  # greedy, in track order: each track takes the best detection still free

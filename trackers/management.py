@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assignment import corner_iou, corners, lapjv, plus_one_iou
-from .bytetrack import tlwh_to_xyah, xyah_to_tlwh
+from .bytetrack import tlwh_to_xyah, xyah_to_corners, xyah_to_tlwh
 from .kalman import xyah_initiate, xyah_predict, xyah_update
 from .sort import CountedTracks, SortTracks, paired_iou
 
@@ -76,7 +76,7 @@ class ByteTracks(CountedTracks):
         mean[~was_tracked, 7] = 0.0
         self.mean, self.cov = xyah_predict(mean, self.cov)
         self._age()
-        predicted = corners(self.boxes())
+        predicted = xyah_to_corners(self.mean)
         boxes = corners(dets[:, :4])
         iou = plus_one_iou(predicted, boxes)
         first = lapjv(1 - iou[:, high] * score[high], self.match_thresh)
