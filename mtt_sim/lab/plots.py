@@ -98,12 +98,16 @@ def bench_plot(records: Sequence[dict], metrics: Sequence[str], path: str | Path
 
 def learning_curve(learning, path: str | Path) -> None:
     """A policy search's fitness per generation: the best so far and the generation's mean, over SORT's rules."""
-    plt, fig, (ax,) = _panels(["fitness"], f"learning from the score: {learning.episodes} training episodes")
+    n = learning.episodes
+    plt, fig, (ax,) = _panels(["fitness"], f"learning from the score: {n} training episode{'s' * (n != 1)}")
+    from matplotlib.ticker import MaxNLocator
     gens = np.arange(1, len(learning.best_so_far) + 1)
     ax.plot(gens, learning.best_so_far, "o-", label="best so far")
     ax.plot(gens, learning.generation_mean, ".", color="0.5", label="generation mean")
     ax.axhline(learning.start_fitness, color="C3", ls="--", label="SORT's rules (the start)")
     ax.set(xlabel="generation", ylabel="fitness")
+    ax.set_xlim(0.5, len(gens) + 0.5)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))  # generations are whole: no tick at 1.5
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
     _save(plt, fig, path)

@@ -133,26 +133,36 @@ def summary(v: Validation) -> list[dict]:
     return rows
 
 
+def cell(value) -> str:
+    """One Markdown table cell: a `|` inside it escaped, so that it does not split the cell."""
+    return str(value).replace("|", "\\|")
+
+
+def row(*cells) -> str:
+    """One Markdown table row of `cells`, each escaped by `cell`."""
+    return "| " + " | ".join(cell(c) for c in cells) + " |"
+
+
 def markdown(v: Validation) -> str:
     """The check's tables: the summary against the goals, per-sequence metrics, the detector statistics."""
-    head = ["| twin | median abs MOTA gap (points) | median abs IDF1 gap (points) | median abs IDSW gap | "
-            "mean Kendall tau, MOTA | mean Kendall tau, IDF1 |", "|---|---:|---:|---:|---:|---:|"]
+    head = [row("twin", "median abs MOTA gap (points)", "median abs IDF1 gap (points)", "median abs IDSW gap",
+                "mean Kendall tau, MOTA", "mean Kendall tau, IDF1"), "|---|---:|---:|---:|---:|---:|"]
     for r in summary(v):
-        head.append(f"| {r['twin']} | {r['median |MOTA gap|']:.1f} | {r['median |IDF1 gap|']:.1f} | "
-                    f"{r['median |IDSW gap|']:.1f} | {r['mean tau MOTA']:.2f} | {r['mean tau IDF1']:.2f} |")
+        head.append(row(r["twin"], f"{r['median |MOTA gap|']:.1f}", f"{r['median |IDF1 gap|']:.1f}",
+                        f"{r['median |IDSW gap|']:.1f}", f"{r['mean tau MOTA']:.2f}", f"{r['mean tau IDF1']:.2f}"))
     goal = (f"Goals: median |MOTA gap| <= {GOALS['MOTA']:g}, median |IDF1 gap| <= {GOALS['IDF1']:g}, mean tau >= "
             f"{GOALS['tau']:g}; twins are the mean of {v.seeds} seeds.")
     parts = ["\n".join(head), goal]
     for m in METRICS:
         fmt = (lambda x: f"{x:.1f}") if m == "IDSW" else (lambda x: f"{100 * x:.1f}")
-        lines = [f"| sequence | tracker | {m} real | " + " | ".join(t.name for t in v.twins) + " |",
+        lines = [row("sequence", "tracker", f"{m} real", *(t.name for t in v.twins)),
                  "|---|---|---:|" + "---:|" * len(v.twins)]
         for s in v.sequences:
             for tr in v.trackers:
                 if (s, tr) not in v.real:
                     continue
                 cells = [fmt(v.twin[t.name, s, tr][m]) if (t.name, s, tr) in v.twin else "failed" for t in v.twins]
-                lines.append(f"| {s} | {tr} | {fmt(v.real[s, tr][m])} | " + " | ".join(cells) + " |")
+                lines.append(row(s, tr, fmt(v.real[s, tr][m]), *cells))
         parts.append("\n".join(lines))
     parts.append(detector_markdown(v))
     if v.failed:
@@ -163,7 +173,7 @@ def markdown(v: Validation) -> str:
 def detector_markdown(v: Validation) -> str:
     """Per sequence, the data's detector statistics beside each same-sequence twin's, and how many lie within 10 %."""
     twins = [t.name for t in v.twins if not t.leave_one_out]
-    lines = ["| sequence | statistic | data | " + " | ".join(twins) + " |", "|---|---|---:|" + "---:|" * len(twins)]
+    lines = [row("sequence", "statistic", "data", *twins), "|---|---|---:|" + "---:|" * len(twins)]
     within = {t: [] for t in twins}
     for s in v.sequences:
         data = v.detector[s, "data"]
@@ -174,7 +184,7 @@ def detector_markdown(v: Validation) -> str:
                 cells.append(f"{x:.3f}")
                 if k in ("P(miss | miss)", "mean miss run", "false positives per frame") and data[k] > 0:
                     within[t].append(abs(x - data[k]) <= GOALS["detector"] * data[k])
-            lines.append(f"| {s} | {k} | {data[k]:.3f} | " + " | ".join(cells) + " |")
+            lines.append(row(s, k, f"{data[k]:.3f}", *cells))
     counts = ", ".join(f"{t}: {sum(w)} of {len(w)}" for t, w in within.items())
     return "\n".join(lines) + (f"\n\nP(miss | miss), mean miss run and false positives per frame within 10 % of the "
                                f"data's: {counts}.")
