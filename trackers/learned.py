@@ -4,6 +4,8 @@ max_age). `mtt-sim learn-policy` trains the policy."""
 
 from __future__ import annotations
 
+import io
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +34,16 @@ def load_policy(path: str | Path) -> np.ndarray:
 
 
 def save_policy(path: str | Path, weights: np.ndarray, **about: str) -> None:
-    """Write a policy: its weights, the feature names they read, and `about` (what it was trained on, how)."""
-    np.savez(path, weights=np.asarray(weights, float), features=np.array(FEATURES), **{k: np.array(v) for k, v in about.items()})
+    """Write a policy: its weights, the feature names they read, and `about` (what it was trained on, how), as an
+    .npz file that np.load reads. Written member by member with a fixed date (np.savez stamps the time of writing),
+    so that the same policy is the same bytes."""
+    arrays = {"weights": np.asarray(weights, float), "features": np.array(FEATURES),
+              **{k: np.array(v) for k, v in about.items()}}
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, array in arrays.items():
+            member = io.BytesIO()
+            np.lib.format.write_array(member, array, allow_pickle=False)
+            archive.writestr(zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0)), member.getvalue())
 
 
 @register

@@ -8,6 +8,7 @@ import json
 import shlex
 import sys
 
+from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (FORCE_HELP, INTERRUPTED, add_overrides, integer, metric_names, output_file,
                                    output_folder, parse_seeds, replaced, require, tracker_specs)
 
@@ -32,6 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--results-dir",
                         help="write every episode's tracks as a MOTChallenge results file in this folder")
     parser.add_argument("--force", action="store_true", help=FORCE_HELP)
+    resuming.add(parser, "--out")
     add_overrides(parser, "overrides for every episode")
 
 
@@ -45,15 +47,19 @@ def check_plot(args) -> None:
 def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> int:
     """Run a bench or sweep grid: records written as they finish, a table(records, metric) per metric, with --plot
     plot(records) (one panel per metric), and the failed episodes at the end, and on Ctrl-C or SIGTERM the workers
-    stopped and what finished kept. Exit status: 0, 1 if an episode failed, 130 if interrupted."""
-    out = output_file(args.out, args.force, "--out", (".csv", ".json"))
+    stopped and what finished kept (and, with --out, its journal, which --resume takes up). Exit status: 0, 1 if an
+    episode failed, 130 if interrupted."""
+    out = output_file(args.out, resuming.force(args, args.out, "--out"), "--out", (".csv", ".json"))
     if args.results_dir:
-        output_folder(args.results_dir, args.force, "--results-dir", "write into it")
+        output_folder(args.results_dir, args.force or args.resume, "--results-dir", "write into it")
     if args.backend == "ray":
         require("ray", "--backend", "ray")
     from mtt_sim.lab import experiment
 
     finished = []
+    definition = {"command": args.command, "trackers": args.trackers, "scenarios": scenarios, "seeds": list(args.seeds),
+                  "config": overrides, "configs": configs, "results_dir": args.results_dir}
+    journal = resuming.journal(out, definition, args.resume, "episodes") if out else None
     record_file = experiment.RecordFile(out) if out else None
 
     def keep(record):
@@ -65,14 +71,15 @@ def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> in
     try:
         records = experiment.run_grid(args.trackers, scenarios, args.seeds, config=overrides, configs=configs,
                                       workers=args.workers, progress=True, backend=args.backend, address=args.address,
-                                      on_record=keep, results_dir=args.results_dir)
+                                      on_record=keep, results_dir=args.results_dir, journal=journal)
     except KeyboardInterrupt:
         records, interrupted = finished, True
     finally:
-        if record_file:
-            record_file.close()
+        for file in filter(None, (record_file, journal)):
+            file.close()
     if out and not interrupted:
         experiment.write_records(records, out)  # again, in grid order
+        journal.finish()
     done = [r for r in records if r is not None]
     print("\n\n".join(filter(None, (table(done, m) for m in args.metric))))
     scored = [r for r in done if r["metrics"] is not None]
@@ -94,6 +101,7 @@ def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> in
     if interrupted:
         size = len(args.trackers) * len(scenarios) * len(args.seeds) * len(configs or [{}])
         print(f"mtt-sim {args.command}: interrupted; {len(done)} of {size} episodes finished"
-              + (f", their records in {out}" if out else ""), file=sys.stderr)
+              + (f", their records in {out}; the same command with --resume runs the rest" if out else ""),
+              file=sys.stderr)
         return INTERRUPTED
     return 1 if failed else 0

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import shutil
+import sys
+from pathlib import Path
 
+from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (
     CONFIG_HELP,
     FORCE_HELP,
+    INTERRUPTED,
     UsageError,
     add_overrides,
     episode_overrides,
@@ -38,6 +43,7 @@ def add(subparsers) -> None:
     p.add_argument("--out", default="policy.npz", help="where to write the policy (default policy.npz)")
     p.add_argument("--plot", help="write the learning curve as a PNG (the [plot] extra)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    resuming.add(p, "--out")
     add_overrides(p, CONFIG_HELP)
     p.set_defaults(func=run)
 
@@ -65,10 +71,25 @@ def run(args) -> int:
     if lower:
         raise UsageError("--metrics", f"{', '.join(lower)}: the fitness is a mean of scores where higher is better "
                                       "(MOTA, IDF1, HOTA, ...)")
-    out = output_file(args.out, args.force, "--out", (".npz",))
-    plot = output_file(args.plot, args.force, "--plot", (".png",))
-    learning = learn_policy(args.on, args.seeds, args.generations, args.population, args.sigma, args.seed,
-                            args.workers, metrics, overrides, args.frames, progress=True, base=args.base)
+    force = resuming.force(args, args.out, "--out")
+    out = output_file(args.out, force, "--out", (".npz",))
+    plot = output_file(args.plot, force, "--plot", (".png",))
+    definition = {"command": "learn-policy", "on": args.on, "seeds": list(args.seeds), "frames": args.frames,
+                  "base": args.base, "population": args.population, "sigma": args.sigma, "metrics": metrics,
+                  "seed": args.seed, "config": overrides}  # not --generations: a resumed search may go on for more
+    journal = resuming.journal(out, definition, args.resume, "episodes")
+    work = Path(f"{out}.work")  # the training episodes and the policies tried, until the search ends
+    try:
+        learning = learn_policy(args.on, args.seeds, args.generations, args.population, args.sigma, args.seed,
+                                args.workers, metrics, overrides, args.frames, progress=True, base=args.base,
+                                work=work, journal=journal)
+    except KeyboardInterrupt:
+        journal.close()
+        print(f"mtt-sim learn-policy: interrupted; the episodes replayed are kept in {journal.path} (and {work}): "
+              "the same command with --resume goes on from there", file=sys.stderr)
+        return INTERRUPTED
+    journal.finish()
+    shutil.rmtree(work)
     save_policy(out, learning.weights, trained_on=",".join(args.on), seeds=str(list(args.seeds)), base=args.base,
                 metrics=",".join(metrics), generations=str(args.generations), seed=str(args.seed))
     print(f"fitness (mean {'/'.join(metrics)} over {learning.episodes} episodes): SORT's rules {learning.start_fitness:.4f}, "

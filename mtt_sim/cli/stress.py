@@ -7,8 +7,9 @@ import json
 import shlex
 import sys
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, UsageError, add_overrides, episode_overrides, integer,
-                                   output_folder, parse_seeds, replaced, require, scenario_key, tracker_spec)
+from mtt_sim.cli import resuming
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_overrides, episode_overrides,
+                                   integer, output_folder, parse_seeds, replaced, require, scenario_key, tracker_spec)
 
 SAMPLERS = ("tpe", "cmaes", "random")
 
@@ -58,6 +59,7 @@ def add(subparsers) -> None:
                                  "history.png (the [plot] extra)")
     p.add_argument("--json", action="store_true", help="print the worst scenes as one JSON object")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    resuming.add(p, "--out")
     add_overrides(p, CONFIG_HELP + "; searched keys are set over them")
     p.set_defaults(func=run)
 
@@ -65,7 +67,7 @@ def add(subparsers) -> None:
 def run(args) -> int:
     require("optuna", "stress", "tune")
     overrides = episode_overrides(args)
-    out = output_folder(args.out, args.force, "--out", "write into it") if args.out else None
+    out = output_folder(args.out, resuming.force(args, args.out, "--out"), "--out", "write into it") if args.out else None
     if out:
         require("matplotlib", "--out", "plot")
     from mtt_sim.lab import stress
@@ -80,16 +82,31 @@ def run(args) -> int:
     except ValueError as err:
         raise UsageError("--objective", str(err)) from None
 
+    definition = {"command": "stress", "spec": args.spec, "scenario": args.scenario, "objective": args.objective,
+                  "vary": [d.text() for d in args.vary], "budget": args.budget, "seeds": list(args.seeds),
+                  "seed": args.seed, "sampler": args.sampler, "against_random": args.against_random, "config": overrides}
+    journal = resuming.journal(out, definition, args.resume, "episodes") if out else None
+
     def searched(sampler: str) -> stress.Search:
         return stress.search(args.spec, args.scenario, args.vary, args.objective, args.budget, args.seeds,
-                             args.seed, args.workers, sampler, overrides, progress=not args.json)
+                             args.seed, args.workers, sampler, overrides, progress=not args.json, journal=journal)
 
-    found = searched(args.sampler)
-    random = searched("random") if args.against_random else None
+    try:
+        found = searched(args.sampler)
+        random = searched("random") if args.against_random else None
+    except KeyboardInterrupt:
+        if not journal:
+            raise
+        journal.close()
+        print(f"mtt-sim stress: interrupted; the scenes evaluated are kept in {journal.path}: the same command with "
+              "--resume goes on from there", file=sys.stderr)
+        return INTERRUPTED
     if not found.scenes:
         raise ValueError("every scene failed: " + "; ".join(sorted({f["error"] for f in found.failed})))
     if out:
-        worst = stress.write(found, out, args.top, shlex.join(["mtt-sim", *sys.argv[1:]]), random)
+        command = shlex.join(["mtt-sim", *(a for a in sys.argv[1:] if a != "--resume")])  # as if never stopped
+        worst = stress.write(found, out, args.top, command, random)
+        journal.finish()
     else:
         worst = [{"scenario": args.scenario, "config": found.config_of(s), "seed": s.seed, "value": s.value,
                   "metrics": s.metrics if len(found.objective.specs) > 1 else s.metrics[args.spec]}

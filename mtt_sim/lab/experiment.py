@@ -26,6 +26,7 @@ from mtt_sim import trackers
 
 from mtt_sim.lab import pool
 from mtt_sim.lab.episode import Episode
+from mtt_sim.lab.journal import Journal
 from mtt_sim.env import TrackingEnv
 from mtt_sim.metrics import METRICS, PER_TARGET
 from mtt_sim.real.motchallenge import write_results
@@ -127,12 +128,14 @@ def _task(task: tuple) -> dict:
 def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequence[int] | int,
              config: Mapping | None = None, configs: Sequence[Mapping] | None = None, workers: int = 1,
              progress: bool = False, backend: str = "local", address: str | None = None,
-             on_record: Callable[[dict], None] | None = None, results_dir: str | Path | None = None) -> list[dict]:
+             on_record: Callable[[dict], None] | None = None, results_dir: str | Path | None = None,
+             journal: Journal | None = None) -> list[dict]:
     """Every tracker x scenario x seed (x config, for sweeps); records in grid order. backend="local" runs them in
     `workers` processes; "ray" as Ray tasks, on a local Ray instance of `workers` CPUs or on the cluster at
     `address` (the [ray] extra). `on_record` is called with each record as it finishes, so an interrupted grid
-    keeps what it finished (KeyboardInterrupt stops the workers and propagates). With `results_dir`, every episode
-    writes its tracks as a MOTChallenge results file, `results_dir/<tracker>/<scenario>[-seed<k>][-<config>].txt`."""
+    keeps what it finished (KeyboardInterrupt stops the workers and propagates); a `journal` keeps them too, and
+    the episodes it holds are not run again. With `results_dir`, every episode writes its tracks as a MOTChallenge
+    results file, `results_dir/<tracker>/<scenario>[-seed<k>][-<config>].txt`."""
     if backend not in BACKENDS:
         raise ValueError(f"backend={backend!r}: allowed values: {', '.join(map(repr, BACKENDS))}")
     seeds = range(seeds) if isinstance(seeds, int) else seeds
@@ -141,18 +144,28 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
     tasks = [(sc, spec, seed, {**(config or {}), **c},
               results_path(results_dir, spec, sc, seed if len(seeds) > 1 else None, c) if results_dir else None)
              for c, sc, spec, seed in itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
-    return run_tasks(tasks, workers, progress, backend, address, on_record)
+    return run_tasks(tasks, workers, progress, backend, address, on_record, journal=journal)
 
 
 def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, backend: str = "local",
               address: str | None = None, on_record: Callable[[dict], None] | None = None,
-              processes: pool.Pool | None = None) -> list[dict]:
+              processes: pool.Pool | None = None, journal: Journal | None = None) -> list[dict]:
     """Episodes (scenario, tracker, seed, config, results file or None) as `run_grid` runs them; records in order.
-    `processes` (from `episode_pool`) runs them in workers already started, instead of `workers` new ones."""
+    `processes` (from `episode_pool`) runs them in workers already started, instead of `workers` new ones. Each
+    finished record goes into `journal`, keyed by its task, and the tasks it already holds are taken from it."""
     records: list = [None] * len(tasks)
-    with tqdm(total=len(tasks), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
-        for i, record in _finished(tasks, workers, backend, address, processes):
+    kept = [i for i, task in enumerate(tasks) if journal is not None and repr(task) in journal]
+    missing = sorted(set(range(len(tasks))) - set(kept))
+    with tqdm(total=len(tasks), initial=len(kept), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
+        for i in kept:
+            records[i] = journal.get(repr(tasks[i]))
+            if on_record:
+                on_record(records[i])
+        for j, record in _finished([tasks[i] for i in missing], workers, backend, address, processes):
+            i = missing[j]
             records[i] = record
+            if journal is not None:
+                journal.put(repr(tasks[i]), record)
             if on_record:
                 on_record(record)
             bar.set_postfix_str(f"{record['tracker']} on {record['scenario']} seed {record['seed']}"

@@ -12,6 +12,7 @@ search whatever the number of workers. A trial whose episode raises is recorded 
 from __future__ import annotations
 
 import ast
+import difflib
 import math
 import operator
 import re
@@ -22,6 +23,7 @@ from typing import Mapping, Sequence
 
 from mtt_sim import trackers
 from mtt_sim.lab.experiment import episode_pool, run_tasks
+from mtt_sim.lab.journal import Journal
 from mtt_sim.metrics import METRICS
 from mtt_sim.sim import scenario as scenarios
 from mtt_sim.sim.config import ConfigError
@@ -72,7 +74,12 @@ def dimension(text: str) -> Dimension:
     names = {str(c).lower(): c for c in allowed}
     picked = tuple(names.get(v.strip().lower(), v) for v in values.split("|")) if sep else allowed
     unknown = [v for v in picked if v not in allowed]
-    if unknown or len(set(picked)) < 2:
+    if unknown:
+        near = difflib.get_close_matches(str(unknown[0]).strip().lower(), names, n=1)
+        raise ConfigError(f"{key}={values}: {str(unknown[0]).strip()!r} is not one of {key}'s choices"
+                          + (f" (did you mean {names[near[0]]!r}?)" if near else "")
+                          + f"; allowed: {'|'.join(map(str, allowed))}")
+    if len(set(picked)) < 2:
         raise ConfigError(f"{key}={values}: expected two or more of {'|'.join(map(str, allowed))}")
     return Dimension(key, kind, choices=picked)
 
@@ -93,7 +100,9 @@ class Objective:
         def placeholder(match) -> str:
             metric = names.get(match.group(1).lower())
             if metric is None:
-                raise ValueError(f"objective {text!r}: unknown metric {match.group(1)!r}; allowed: "
+                near = difflib.get_close_matches(match.group(1).lower(), names, n=1)
+                raise ValueError(f"objective {text!r}: unknown metric {match.group(1)!r}"
+                                 + (f" (did you mean {names[near[0]]!r}?)" if near else "") + "; allowed: "
                                  + ", ".join(m for m in METRICS if m.isidentifier()))
             term = (metric, (match.group(2) or spec).strip())
             if term not in self.terms:
@@ -204,13 +213,18 @@ def check_bounds(scenario: str, dimensions: Sequence[Dimension], config: Mapping
     """Every bound of every dimension makes a valid scene with `config`, or the ConfigError says which does not."""
     for dim in dimensions:
         for value in (dim.choices or (dim.low, dim.high)):
-            scenarios.load(scenario, {**config, dim.key: value})
+            try:
+                scenarios.load(scenario, {**config, dim.key: value})
+            except ConfigError as err:
+                raise ConfigError(f"{dim.key}={value} makes no valid scene: {err}") from None
 
 
 def search(spec: str, scenario: str, dimensions: Sequence[Dimension], objective: str, budget: int,
            seeds: Sequence[int] = (0,), seed: int = 0, workers: int = 1, sampler_name: str = "tpe",
-           config: Mapping | None = None, progress: bool = False) -> Search:
-    """Search `budget` scenes of `scenario` over `dimensions` for the largest `objective` of tracker `spec`."""
+           config: Mapping | None = None, progress: bool = False, journal: Journal | None = None) -> Search:
+    """Search `budget` scenes of `scenario` over `dimensions` for the largest `objective` of tracker `spec`. The
+    episodes of each scene go into `journal`; a scene it holds is not run again but taken from it, so a search
+    resumed from a journal replays the sampler's choices to the same scenes."""
     import optuna
 
     wanted = Objective(objective, spec)
@@ -223,7 +237,7 @@ def search(spec: str, scenario: str, dimensions: Sequence[Dimension], objective:
     def evaluate(trial) -> float:
         params = {d.key: d.suggest(trial) for d in dimensions}
         tasks = [(scenario, s, k, {**config, **params}, None) for k in seeds for s in wanted.specs]
-        records = run_tasks(tasks, workers, processes=processes)
+        records = run_tasks(tasks, workers, processes=processes, journal=journal)
         failed = next((r for r in records if r["error"]), None)
         if failed:
             raise RuntimeError(f"{failed['tracker']} seed {failed['seed']}: {failed['error']}")
