@@ -79,7 +79,14 @@ def open_source(what: str | os.PathLike | Scenario, overrides: Mapping | None = 
     if recorded or (not isinstance(what, Scenario) and is_sequence(what)):
         from mtt_sim.real.sequence import Recording
 
-        return Recording(what, benchmark, overrides)
+        recording = Recording(what, benchmark, overrides)
+        if recording.config.sensor.model == "recorded" and not recording.detection_rows:
+            det = Path(what) / "det" / "det.txt"
+            raise ConfigError(f"{det}: " + ("no detection rows" if det.is_file() else "not found")
+                              + ": nothing to replay as the sequence's recorded detections; replay its ground truth "
+                                "through the synthetic detector instead (--detector synthetic, sensor.model = "
+                                "'synthetic')")
+        return recording
     if benchmark is not None:
         raise ValueError(f"benchmark={benchmark!r} applies to recorded sequences, not to the scenario {what!r}")
     from mtt_sim.sim.scene import Scene

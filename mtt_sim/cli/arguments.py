@@ -8,13 +8,20 @@ mistyped argument is answered at once.
 from __future__ import annotations
 
 import argparse
+import configparser
+import dataclasses
 import importlib.util
+import math
 import os
+import sys
 import tomllib
 from pathlib import Path
+from typing import Sequence
 
 from mtt_sim import sources
+from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario
+from mtt_sim.sim.config import SensorConfig, table
 
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
                 "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
@@ -62,6 +69,24 @@ def fraction(text: str) -> float:
     return value
 
 
+def number(lo: float | None = None, hi: float | None = None, lo_open: bool = True):
+    """A finite number type above lo (or at least lo, with lo_open=False) and at most hi."""
+    allowed = "a number" + (f" {'>' if lo_open else '>='} {lo:g}" if lo is not None else "") + \
+        (f" and <= {hi:g}" if hi is not None else "")
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not math.isfinite(value) or (lo is not None and (value <= lo if lo_open else value < lo)) or \
+                (hi is not None and value > hi):
+            raise argparse.ArgumentTypeError(f"must be {allowed}, got {text!r}")
+        return value
+
+    return parse
+
+
 def parse_seeds(text: str) -> list[int]:
     """Seeds from a count ("5": 0..4), a list ("3,7,11"), a range ("100-199") or a list of both ("0-4,9")."""
     text = text.strip()
@@ -87,11 +112,17 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def scenario_key(text: str) -> str:
-    """A scenario as the loader names it (a key, an env id, a .toml file or a sequence folder)."""
+    """A scenario as the loader names it (a key, an env id, a .toml file or a sequence folder); a .toml file is read
+    whole here, so that a mistyped key in it is named with the file (not blamed on --config)."""
     try:
-        return str(sources.resolve(text))
+        found = sources.resolve(text)
+        if isinstance(found, Path) and not found.is_dir():
+            scenario.load(found)
+        return str(found)
     except scenario.ConfigError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot be read ({err})") from None
 
 
 def scenario_keys(text: str) -> list[str]:
@@ -138,7 +169,32 @@ def calibration_folder(text: str) -> str:
     if not folder.is_dir() or missing:
         raise argparse.ArgumentTypeError(f"{text!r} is not a sequence folder with gt/gt.txt and det/det.txt"
                                          + (f" (no {missing[0]})" if folder.is_dir() else ""))
+    for name in ("det/det.txt", "gt/gt.txt"):
+        rows_in(folder / name, "argument DIR")
+    sequence_read(text)
     return text
+
+
+def rows_in(path: Path, argument: str) -> None:
+    """A MOTChallenge file with at least one row, or an ArgumentTypeError naming it."""
+    try:
+        with open(path, "rb") as f:
+            empty = not any(line.strip() for line in f)
+    except OSError as err:
+        raise argparse.ArgumentTypeError(f"{str(path)!r} cannot be read ({err.strerror})") from None
+    if empty:
+        raise argparse.ArgumentTypeError(f"{str(path)!r} has no rows: nothing to fit to or compare with")
+
+
+def sequence_read(folder: str) -> None:
+    """The sequence folder's files read as a run reads them (rows, frames, seqinfo.ini), or an ArgumentTypeError with
+    the file and row."""
+    from mtt_sim.real.sequence import Recording
+
+    try:
+        Recording(folder)
+    except ValueError as err:  # ConfigError too
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def metric_names(text: str) -> list[str]:
@@ -185,8 +241,17 @@ def parse_overrides(items: list[str]) -> dict:
         key, sep, value = item.partition("=")
         if not sep or not key:
             raise UsageError("--config", f"{item!r}: expected key=value, e.g. sensor.clutter_rate=5")
+        if key in out:
+            raise UsageError("--config", f"{key} is given twice ({key}={out[key]!r}, then {item!r}); give it once")
         out[key] = toml_value(value)
     return out
+
+
+@dataclasses.dataclass(frozen=True)
+class _SensorFile:
+    """What a --sensor file holds: one [sensor] table (checked key by key as a scenario's)."""
+
+    sensor: SensorConfig = table(SensorConfig, "the detector")
 
 
 def episode_overrides(args) -> dict:
@@ -194,10 +259,11 @@ def episode_overrides(args) -> dict:
     out = {}
     if args.sensor:
         try:
-            table = scenario.read_sensor(args.sensor)["sensor"]
+            sensor = scenario.read_sensor(args.sensor)
+            scenario.from_mapping(sensor, args.sensor, _SensorFile)  # every key and value of the file checked
         except scenario.ConfigError as err:
             raise UsageError("--sensor", str(err)) from None
-        out.update({f"sensor.{k}": v for k, v in table.items()})
+        out.update({f"sensor.{k}": v for k, v in sensor["sensor"].items()})
     if args.detector:
         out["sensor.model"] = args.detector
     out.update(parse_overrides(args.config))
@@ -213,6 +279,10 @@ def loaded(scenarios: list[str], config: dict, argument: str = "--config", confi
             try:
                 sources.open_source(sc, {**config, **extra})
             except scenario.ConfigError as err:
+                try:
+                    sources.open_source(sc)
+                except scenario.ConfigError as own:  # the source itself, whatever the overrides: its file names it
+                    raise own from None
                 raise UsageError(argument, str(err)) from None
 
 
@@ -255,6 +325,66 @@ def require(module: str, argument: str, extra: str) -> None:
         found = False
     if not found:
         raise UsageError(argument, f"needs {module}: pip install 'mtt-sim[{extra}]'")
+
+
+# ------------------------------------------------------------------ the estimate of the work, and --dry-run
+
+DRY_RUN_HELP = "check every argument as a run would, print an estimate of the work and stop: nothing runs or is written"
+
+
+def add_dry_run(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--dry-run", action="store_true", help=DRY_RUN_HELP)
+
+
+def episode_frames(source: str, overrides: dict | None = None, steps: int | None = None) -> int:
+    """The frames of one episode of `source` with `overrides`, cheaply: a scenario's env.max_steps (its file read, no
+    world built), a sequence's seqLength (or its length as read), at most `steps`."""
+    overrides = overrides or {}
+    if is_sequence(source):
+        ini = configparser.ConfigParser()
+        ini.optionxform = str
+        try:
+            length = int(ini["Sequence"]["seqLength"]) if ini.read(Path(source) / "seqinfo.ini") else None
+        except (KeyError, ValueError, configparser.Error):
+            length = None
+        if length is None:
+            length = sources.open_source(source, overrides).length
+        limit = scenario.expand_dotted(overrides).get("env", {}).get("max_steps")
+        frames = length if limit is None else min(length, limit)
+    else:
+        frames = scenario.load(source, overrides).env.max_steps
+    return frames if steps is None else min(frames, steps)
+
+
+def estimate(command: str, factors: Sequence[tuple[int, str]], sources_: Sequence[str] = (),
+             overrides: dict | None = None, configs: Sequence[dict] = ({},), steps: int | None = None,
+             unit: str = "episodes") -> str:
+    """One line of the work a command is about to do, e.g. 'bench: 2 trackers x 3 scenarios x 5 seeds = 30 episodes,
+    about 9000 frames': the product of `factors` (count, plural noun), and where `sources_` are given the frames, each
+    episode as long as the mean episode of the sources under each of `configs` (see `episode_frames`)."""
+    total = math.prod(n for n, _ in factors)
+    counted = [f"{n} {_noun(n, what)}" for n, what in factors]
+    line = f"{command}: " + (f"{' x '.join(counted)} = " if len(factors) > 1 or factors[0][1] != unit else "") + \
+        f"{total} {_noun(total, unit)}"
+    if sources_:
+        lengths = [episode_frames(s, {**(overrides or {}), **c}, steps) for s in sources_ for c in configs]
+        line += f", about {round(total * sum(lengths) / len(lengths))} frames"
+    return line
+
+
+def _noun(n: int, plural: str) -> str:
+    return plural[:-1] if n == 1 and plural.endswith("s") else plural
+
+
+def dry_run(args, line: str, announce: bool = False) -> bool:
+    """The estimate `line`: with --dry-run printed (stdout) and True, the command stops there; otherwise printed on
+    stderr where `announce` (a long run says what it is about to do; stdout and --json stay clean) and False."""
+    if getattr(args, "dry_run", False):
+        print(line)
+        return True
+    if announce:
+        print(line, file=sys.stderr, flush=True)
+    return False
 
 
 # ------------------------------------------------------------------ what the commands print

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import shlex
 
-from mtt_sim.cli.arguments import FORCE_HELP, calibration_folder, integer, output_file, replaced
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, dry_run, estimate, integer, output_file,
+                                   replaced)
 
 
 def add(subparsers) -> None:
@@ -16,14 +17,18 @@ def add(subparsers) -> None:
     p.add_argument("--out", required=True, help="the [sensor] table to write (.toml)")
     p.add_argument("--seeds", type=integer(1), default=3, help="twin runs averaged in the check (default 3)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".toml",))
+    if dry_run(args, estimate("calibrate", [(len(args.folders), "sequences"), (args.seeds, "seeds")], args.folders,
+                              unit="twin runs"), announce=True):
+        return 0
     from mtt_sim.sim2real import calibrate
 
-    fitted = calibrate.calibrate(args.folders, seeds=args.seeds)
+    fitted = calibrate.calibrate(args.folders, seeds=args.seeds, progress=True)
     print(calibrate.report(fitted))
     out.write_text(calibrate.to_toml(fitted))
     print(f"\nsensor: {out}" + replaced(args.force)

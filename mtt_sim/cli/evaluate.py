@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from mtt_sim.cli.arguments import SUMMARY_KEYS, UsageError, fraction, print_summary
+from mtt_sim.cli.arguments import SUMMARY_KEYS, UsageError, add_dry_run, dry_run, estimate, fraction, print_summary
 from mtt_sim.sim import scenario
 
 
@@ -20,6 +20,7 @@ def add(subparsers) -> None:
     p.add_argument("--similarity", choices=("iou", "centroid"), default="iou")
     p.add_argument("--threshold", type=fraction, default=0.5, help="match threshold in (0, 1] (default 0.5)")
     p.add_argument("--json", action="store_true")
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -30,6 +31,13 @@ def run(args) -> int:
             raise UsageError(argument, f"{str(path)!r} not found; expected {kind}")
     from mtt_sim.real import motchallenge
 
+    if args.dry_run:  # the files read and checked as the scoring reads them, nothing scored
+        from mtt_sim.real.sequence import Recording, check_frames, read_rows
+
+        recording = Recording(args.gt, args.benchmark)
+        check_frames(Path(args.results), read_rows(args.results, 6), len(recording))
+        dry_run(args, estimate("eval", [(len(recording), "frames scored")], unit="frames scored"))
+        return 0
     s = scenario.ScoringConfig()
     metrics = motchallenge.evaluate_results(args.gt, args.results, benchmark=args.benchmark, similarity=args.similarity,
                                             threshold=args.threshold, zero_distance=s.zero_distance,

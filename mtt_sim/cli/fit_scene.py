@@ -7,7 +7,8 @@ import argparse
 import shlex
 from pathlib import Path
 
-from mtt_sim.cli.arguments import FORCE_HELP, integer, output_file, replaced
+from mtt_sim.cli.arguments import (FORCE_HELP, UsageError, add_dry_run, dry_run, estimate, integer, output_file,
+                                   replaced, rows_in, sequence_read)
 
 
 def detections_folder(text: str) -> str:
@@ -16,6 +17,8 @@ def detections_folder(text: str) -> str:
     if not folder.is_dir() or not (folder / "det" / "det.txt").is_file():
         raise argparse.ArgumentTypeError(f"{text!r} is not a sequence folder with det/det.txt"
                                          + (" (no det/det.txt)" if folder.is_dir() else ""))
+    rows_in(folder / "det" / "det.txt", "DIR")
+    sequence_read(text)
     return text
 
 
@@ -28,15 +31,23 @@ def add(subparsers) -> None:
     p.add_argument("--out", required=True, help="the scenario to write (.toml)")
     p.add_argument("--seeds", type=integer(1), default=2, help="scene runs averaged in the check (default 2)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".toml",))
+    from mtt_sim.cli.arguments import _SensorFile
     from mtt_sim.sim import scenario
     from mtt_sim.sim2real import fit_scene
 
-    scenario.read_sensor(args.sensor)  # a bad sensor file fails before any work
+    try:  # a bad sensor file fails before any work, every key checked
+        scenario.from_mapping(scenario.read_sensor(args.sensor), args.sensor, _SensorFile)
+    except scenario.ConfigError as err:
+        raise UsageError("--sensor", str(err)) from None
+    if dry_run(args, estimate("fit-scene", [(1 + args.seeds, "runs (the sequence linked, then the scene's seeds)")],
+                              [args.folder], {"sensor.model": "synthetic"})):
+        return 0
     _, real, scene, text = fit_scene.fit_scene(args.folder, args.sensor, seeds=tuple(range(args.seeds)))
     print(fit_scene.report(real, scene, Path(args.folder).name))
     out.write_text(text)

@@ -9,8 +9,9 @@ import shlex
 import sys
 
 from mtt_sim.cli import resuming
-from mtt_sim.cli.arguments import (FORCE_HELP, INTERRUPTED, add_overrides, integer, metric_names, output_file,
-                                   output_folder, parse_seeds, replaced, require, tracker_specs)
+from mtt_sim.cli.arguments import (FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides, dry_run, estimate,
+                                   integer, metric_names, output_file, output_folder, parse_seeds, replaced, require,
+                                   tracker_specs)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -35,6 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help=FORCE_HELP)
     resuming.add(parser, "--out")
     add_overrides(parser, "overrides for every episode")
+    add_dry_run(parser)
 
 
 def check_plot(args) -> None:
@@ -54,6 +56,12 @@ def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> in
         output_folder(args.results_dir, args.force or args.resume, "--results-dir", "write into it")
     if args.backend == "ray":
         require("ray", "--backend", "ray")
+    elif args.address:
+        raise UsageError("--address", f"{args.address!r}: a Ray cluster's address goes with --backend ray")
+    columns = (len(configs), "values") if configs else (len(scenarios), "scenarios")
+    if dry_run(args, estimate(args.command, [(len(args.trackers), "trackers"), columns, (len(args.seeds), "seeds")],
+                              scenarios, overrides, configs or ({},)), announce=True):
+        return 0
     from mtt_sim.lab import experiment
 
     finished = []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import shutil
 import sys
 from pathlib import Path
@@ -13,12 +14,17 @@ from mtt_sim.cli.arguments import (
     FORCE_HELP,
     INTERRUPTED,
     UsageError,
+    add_dry_run,
     add_overrides,
+    dry_run,
     episode_overrides,
+    estimate,
     integer,
     loaded,
+    number,
     output_file,
     parse_seeds,
+    require,
     scenario_keys,
 )
 
@@ -36,7 +42,8 @@ def add(subparsers) -> None:
                    help="the tracker whose association proposes the candidates: sort or bytetrack (default sort)")
     p.add_argument("--generations", type=integer(1), default=20, help="CMA-ES generations (default 20)")
     p.add_argument("--population", type=integer(4), help="policies a generation (default: CMA-ES's for 30 weights, 14)")
-    p.add_argument("--sigma", type=float, default=1.0, help="CMA-ES's first step size on the weights (default 1)")
+    p.add_argument("--sigma", type=number(0), default=1.0,
+                   help="CMA-ES's first step size on the weights, a number > 0 (default 1)")
     p.add_argument("--metrics", default="MOTA,HOTA", help="the fitness: the mean of these metrics (default MOTA,HOTA)")
     p.add_argument("--seed", type=integer(0), default=0, help="one seed, one policy (default 0)")
     p.add_argument("--workers", type=integer(1), default=1, help="processes running a generation's episodes (default 1)")
@@ -45,6 +52,7 @@ def add(subparsers) -> None:
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     resuming.add(p, "--out")
     add_overrides(p, CONFIG_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -74,6 +82,13 @@ def run(args) -> int:
     force = resuming.force(args, args.out, "--out")
     out = output_file(args.out, force, "--out", (".npz",))
     plot = output_file(args.plot, force, "--plot", (".png",))
+    if plot:
+        require("matplotlib", "--plot", "plot")
+    population = args.population or 4 + int(3 * math.log(30))  # CMA-ES's own for the policy's 30 weights
+    work_done = [(args.generations, "generations"), (population, "policies"), (len(args.on), "sources"),
+                 (len(args.seeds), "seeds")]
+    if dry_run(args, estimate("learn-policy", work_done, args.on, overrides, steps=args.frames), announce=True):
+        return 0
     definition = {"command": "learn-policy", "on": args.on, "seeds": list(args.seeds), "frames": args.frames,
                   "base": args.base, "population": args.population, "sigma": args.sigma, "metrics": metrics,
                   "seed": args.seed, "config": overrides}  # not --generations: a resumed search may go on for more

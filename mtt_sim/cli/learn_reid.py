@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mtt_sim.cli.arguments import (FORCE_HELP, SCENARIO_HELP, integer, output_file, parse_seeds, print_fields,
-                                   scenario_key)
+from mtt_sim.cli.arguments import (FORCE_HELP, SCENARIO_HELP, UsageError, add_dry_run, dry_run, estimate, integer,
+                                   output_file, parse_seeds, print_fields, scenario_key)
+from mtt_sim.real.layout import is_sequence
 
 
 def add(subparsers) -> None:
@@ -19,14 +20,21 @@ def add(subparsers) -> None:
     p.add_argument("--out", default="xqda.npz", help="where to write the metric (default: xqda.npz here)")
     p.add_argument("--install", action="store_true", help="replace the metric the package ships (every lmb uses it)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from mtt_sim.trackers import reid
 
+    if is_sequence(args.scenario):
+        raise UsageError("--scenario", f"{args.scenario!r} is a sequence folder: crops are rendered from a simulated "
+                                       "scenario, a key or a .toml file")
     out = reid.METRIC_FILE if args.install else Path(args.out)
     output_file(str(out), args.force or args.install, "--out", (".npz",))
+    if dry_run(args, estimate("learn-reid", [(len(args.seeds), "seeds")], [args.scenario], steps=args.frames,
+                              unit="episodes")):
+        return 0
     from mtt_sim.lab import learn_reid
 
     print_fields(learn_reid.learn(out, args.scenario, args.seeds, args.frames, args.every, args.dims, progress=True))

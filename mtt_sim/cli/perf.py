@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mtt_sim.cli.arguments import integer
+from mtt_sim.cli.arguments import add_dry_run, dry_run, estimate, integer
 
 
 def add(subparsers) -> None:
@@ -14,6 +14,7 @@ def add(subparsers) -> None:
     p.add_argument("--steps", type=integer(1), default=200, help="env steps per repeat (default 200)")
     p.add_argument("--sections", type=sections, default=None,
                    help=f"only these tables, comma-separated: {', '.join(SECTIONS)} (default all)")
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -30,6 +31,9 @@ def sections(text: str) -> list[str]:
 
 
 def run(args) -> int:
+    if dry_run(args, estimate("perf", [(len(args.sections or SECTIONS), "tables"), (args.repeats, "repeats")],
+                              unit="measurements")):
+        return 0
     from tqdm import tqdm
 
     from mtt_sim.lab import perf

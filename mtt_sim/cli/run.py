@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, SCENARIO_HELP, SUMMARY_KEYS, UsageError, add_overrides,
-                                   episode_overrides, integer, loaded, output_file, print_summary, replaced,
-                                   scenario_key, tracker_spec, tracker_specs)
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, SCENARIO_HELP, SUMMARY_KEYS, UsageError, add_dry_run,
+                                   add_overrides, dry_run, episode_overrides, estimate, integer, loaded, output_file,
+                                   print_summary, replaced, scenario_key, tracker_spec, tracker_specs)
 
 
 def add(subparsers) -> None:
@@ -28,6 +28,7 @@ def add(subparsers) -> None:
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     add_overrides(p, CONFIG_HELP)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -39,6 +40,9 @@ def run(args) -> int:
     if args.compare and args.results:
         raise UsageError("--results", "a results file takes one tracker: leave out --compare")
     specs = args.compare or [args.tracker]
+    if dry_run(args, estimate("run", [(len(specs), "trackers"), (1, "seeds")], [args.scenario], overrides,
+                              steps=args.steps)):
+        return 0
     from mtt_sim.lab import experiment
 
     records = experiment.run_episodes(args.scenario, specs, args.seed, overrides, video=args.video, steps=args.steps,

@@ -8,8 +8,9 @@ import shlex
 import sys
 
 from mtt_sim.cli import resuming
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_overrides, episode_overrides,
-                                   integer, output_folder, parse_seeds, replaced, require, scenario_key, tracker_spec)
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
+                                   dry_run, episode_overrides, estimate, integer, output_folder, parse_seeds, replaced,
+                                   require, scenario_key, tracker_spec)
 
 SAMPLERS = ("tpe", "cmaes", "random")
 
@@ -31,11 +32,23 @@ def dimensions(text: str) -> list:
     return found
 
 
+def scenario_to_vary(text: str) -> str:
+    """A scenario key or .toml file: what has keys to vary (a recorded sequence has none to search)."""
+    from mtt_sim.real.layout import is_sequence
+
+    if is_sequence(text):
+        raise argparse.ArgumentTypeError(f"{text!r} is a sequence folder: stress varies a scenario's keys, so it takes "
+                                         "a scenario key or a .toml file (a sequence's twin is tuned with mtt-sim tune "
+                                         "and checked with mtt-sim validate)")
+    return scenario_key(text)
+
+
 def add(subparsers) -> None:
     p = subparsers.add_parser("stress", help="search scenario keys for the scenes that break a tracker (Optuna): the "
                                              "worst scenes as runnable files, stills and videos")
     p.add_argument("spec", type=tracker_spec, help="the tracker under test, e.g. sort or 'lmb:reid=false'")
-    p.add_argument("--scenario", type=scenario_key, required=True, help="a scenario key or .toml file to vary")
+    p.add_argument("--scenario", type=scenario_to_vary, required=True,
+                   help="a scenario key or .toml file to vary (not a sequence folder: it has no keys to vary)")
     p.add_argument("--vary", type=dimensions, required=True, metavar="KEY=LO:HI[,KEY=A|B ...]",
                    help="the keys searched: numbers between LO and HI, or some of a key's choices (a key alone: all "
                         "of them), within the key's own range; e.g. sensor.clutter_rate=0:10,render.camera=static|shake")
@@ -61,6 +74,7 @@ def add(subparsers) -> None:
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     resuming.add(p, "--out")
     add_overrides(p, CONFIG_HELP + "; searched keys are set over them")
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -78,9 +92,13 @@ def run(args) -> int:
     except ConfigError as err:
         raise UsageError("--vary", str(err)) from None
     try:
-        stress.Objective(args.objective, args.spec)
+        objective = stress.Objective(args.objective, args.spec)
     except ValueError as err:
         raise UsageError("--objective", str(err)) from None
+    scenes = [(args.budget * (2 if args.against_random else 1), "scenes"), (len(args.seeds), "seeds"),
+              (len(objective.specs), "trackers")]
+    if dry_run(args, estimate("stress", scenes, [args.scenario], overrides), announce=True):
+        return 0
 
     definition = {"command": "stress", "spec": args.spec, "scenario": args.scenario, "objective": args.objective,
                   "vary": [d.text() for d in args.vary], "budget": args.budget, "seeds": list(args.seeds),

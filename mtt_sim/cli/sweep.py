@@ -21,6 +21,9 @@ def run(args) -> int:
     if not sep or not key or not values:
         raise UsageError("--param", f"{args.param!r}: expected key=v1,v2,..., e.g. sensor.clutter_rate=0,5,10")
     values = [toml_value(v) for v in values.split(",")]
+    repeated = next((v for i, v in enumerate(values) if v in values[:i]), None)
+    if repeated is not None:
+        raise UsageError("--param", f"{args.param!r}: the value {repeated!r} is given twice; each value once")
     overrides = episode_overrides(args)
     loaded([args.scenario], overrides)
     loaded([args.scenario], overrides, "--param", [{key: v} for v in values])

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from mtt_sim.cli.arguments import FORCE_HELP, calibration_folder, integer, output_file, replaced, tracker_specs
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, dry_run, estimate, integer, output_file,
+                                   replaced, tracker_specs)
 
 
 def add(subparsers) -> None:
@@ -16,6 +17,7 @@ def add(subparsers) -> None:
     p.add_argument("--workers", type=integer(1), default=1, help="parallel processes (default 1)")
     p.add_argument("--out", help="also write the tables to this Markdown file (.md)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -23,7 +25,13 @@ def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".md",))
     from mtt_sim.sim2real import validate
 
-    result = validate.validate(args.folders, args.trackers or validate.TRACKERS, seeds=args.seeds, workers=args.workers,
+    specs = args.trackers or validate.TRACKERS
+    twins = [t for t in validate.TWINS if len(args.folders) > 1 or not t.leave_one_out]
+    runs = (len(args.folders), "sequences"), (len(specs), "trackers"), (1 + len(twins) * args.seeds, "runs (1 real, "
+                                                                         f"{len(twins)} twins x {args.seeds} seeds)")
+    if dry_run(args, estimate("validate", runs, args.folders), announce=True):
+        return 0
+    result = validate.validate(args.folders, specs, seeds=args.seeds, workers=args.workers,
                                progress=True)
     text = validate.markdown(result)
     print(text)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 from mtt_sim.metrics.episode import METRICS
@@ -31,7 +32,9 @@ def goals(text: str) -> list[Goal]:
     for item in filter(None, (i.strip() for i in text.split(","))):
         sign, name = (item[0], item[1:]) if item[0] in "+-" else ("", item)
         if name.lower() not in names:
-            raise ValueError(f"unknown metric {name!r}; available: {', '.join(METRICS)}")
+            near = difflib.get_close_matches(name.lower(), names, n=1)
+            raise ValueError(f"unknown metric {name!r}" + (f" (did you mean {names[near[0]]!r}?)" if near else "")
+                             + f"; available: {', '.join(METRICS)}")
         metric = names[name.lower()]
         out.append(Goal(metric, sign == "+" or (not sign and metric not in LOWER_IS_BETTER)))
     if not out or len({g.metric for g in out}) != len(out):

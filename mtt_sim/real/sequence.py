@@ -37,7 +37,8 @@ PEDESTRIAN = 1
 DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
 PEOPLE = (1, 2, 7, 8, 12)  # pedestrian, person on vehicle, static person, distractor, reflection
 VALID_CLASSES = range(1, 14)
-FRAME_RATE = 30.0  # where seqinfo.ini gives none
+FRAME_RATE = 30.0  # where there is no seqinfo.ini
+REQUIRED_INFO = ("frameRate", "seqLength", "imWidth", "imHeight")  # what a seqinfo.ini must give
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,7 @@ class Recording:
         self.has_images = (self.folder / self.info.image_dir).is_dir()
         counts = np.diff(self._det[1])
         self.max_detections = int(counts.max()) if len(counts) else 0
+        self.detection_rows = len(det)  # none: nothing to replay as recorded (open_source refuses it)
         self.det_range = (det[:, 2:7].min(axis=0), det[:, 2:7].max(axis=0)) if len(det) else (np.zeros(5), np.zeros(5))
         self.config = self._configure(overrides or {})
         self.image_size = (self.info.width, self.info.height)
@@ -221,10 +223,19 @@ def twin_sensor(cfg: SensorConfig, image_size: tuple[int, int], rng: np.random.G
 
 
 def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
-    """seqinfo.ini's fields; where missing, the image files', then the data's (frame rate: 30)."""
+    """seqinfo.ini's fields (a seqinfo.ini must give all four of REQUIRED_INFO); without one, the image files', then
+    the data's (frame rate: 30)."""
     ini = configparser.ConfigParser()
     ini.optionxform = str
-    section = ini["Sequence"] if ini.read(folder / "seqinfo.ini") and "Sequence" in ini else {}
+    path = folder / "seqinfo.ini"
+    try:
+        found = ini.read(path)
+    except (configparser.Error, UnicodeDecodeError) as err:
+        raise scn.ConfigError(f"{path}: not an INI file with a [Sequence] section "
+                              f"({str(err).splitlines()[0].rstrip('.')})") from None
+    if found and "Sequence" not in ini:
+        raise scn.ConfigError(f"{path}: no [Sequence] section (expected name, frameRate, seqLength, imWidth, imHeight)")
+    section = ini["Sequence"] if found else {}
     image_dir, image_ext = section.get("imDir", "img1"), section.get("imExt", ".jpg")
     images = sorted((folder / image_dir).glob(f"*{image_ext}")) if (folder / image_dir).is_dir() else []
     rows = np.concatenate([d[:, :6] for d in data])
@@ -252,8 +263,12 @@ def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
     width = number("imWidth", int, lambda: image_size()[0])
     height = number("imHeight", int, lambda: image_size()[1])
     length = number("seqLength", int, lambda: len(images) or int(rows[:, 0].max(initial=1)))
-    return SequenceInfo(section.get("name", folder.name), width, height,
-                        float(number("frameRate", float, lambda: FRAME_RATE)), length, image_dir, image_ext)
+    frame_rate = float(number("frameRate", float, lambda: FRAME_RATE))
+    missing = [key for key in REQUIRED_INFO if key not in section]
+    if found and missing:  # a seqinfo.ini that leaves one out is a mistake, not a sequence to guess the size of
+        raise scn.ConfigError(f"{path}: [Sequence] has no {missing[0]}; a seqinfo.ini gives "
+                              f"{', '.join(REQUIRED_INFO)} (leave the file out to take them from the frames and data)")
+    return SequenceInfo(section.get("name", folder.name), width, height, frame_rate, length, image_dir, image_ext)
 
 
 def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
@@ -268,16 +283,34 @@ def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
                          "y, w, h, ...)") from None
     if not text:
         return np.zeros((0, min_columns))
-    try:
-        rows = np.array([[float(v) for v in line.replace(" ", "").split(",")] for line in text.splitlines()])
-    except ValueError as err:
-        raise ValueError(f"{path}: not a comma-separated MOTChallenge file ({err})") from None
-    if rows.ndim != 2 or rows.shape[1] < min_columns:
-        raise ValueError(f"{path}: every row needs at least {min_columns} comma-separated values "
-                         "(frame, id, x, y, w, h, ...)")
+    rows = []
+    for number, line in enumerate(text.splitlines(), 1):
+        values = line.replace(" ", "").split(",")
+        if len(values) < min_columns:
+            raise ValueError(f"{path}: row {number} has {len(values)} comma-separated values, {line.strip()!r}; every "
+                             f"row needs at least {min_columns} (frame, id, x, y, w, h, ...)")
+        try:
+            rows.append([float(v) for v in values])
+        except ValueError:
+            bad = next(v for v in values if not _is_number(v))
+            raise ValueError(f"{path}: row {number}: {bad!r} is not a number ({line.strip()!r}); expected "
+                             "comma-separated MOTChallenge rows (frame, id, x, y, w, h, ...)") from None
+    if len({len(r) for r in rows}) > 1:
+        number = next(i for i, r in enumerate(rows, 1) if len(r) != len(rows[0]))
+        raise ValueError(f"{path}: row {number} has {len(rows[number - 1])} values, row 1 has {len(rows[0])}: every "
+                         "row needs the same columns")
+    rows = np.array(rows)
     if not np.isfinite(rows[:, :6]).all():
         raise ValueError(f"{path}: row {int(np.flatnonzero(~np.isfinite(rows[:, :6]).all(1))[0]) + 1} is not finite")
     return rows
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def check_frames(path: Path, rows: np.ndarray | None, length: int) -> None:

@@ -375,7 +375,11 @@ def read(folder: str | Path) -> Source:
     if not rec.scored or not (Path(folder) / "det" / "det.txt").is_file():
         raise scn.ConfigError(f"{folder}: calibrating needs both gt/gt.txt and det/det.txt")
     truths = [rec.truth(k) for k in range(len(rec))]
-    return Source(rec, truths, associate(truths, [rec.detections(k) for k in range(len(rec))]))
+    associated = associate(truths, [rec.detections(k) for k in range(len(rec))])
+    if not associated.detected.any():
+        raise scn.ConfigError(f"{folder}: no detection of a person to fit to (none of the {rec.detection_rows} rows of "
+                              "det/det.txt overlaps a person of gt/gt.txt)")
+    return Source(rec, truths, associated)
 
 
 def twin_detections(source: Source, sensor: dict, seed: int) -> list[np.ndarray]:
@@ -398,10 +402,16 @@ def scenario_statistics(scenario: str, config: dict | None = None, seeds: Sequen
     return statistics(associate(truths, detections))
 
 
-def twin_statistics(sources: Sequence[Source], sensor: dict, seeds: int) -> dict:
-    """`statistics` of the twin's detections on these sequences, the mean over `seeds` runs."""
-    runs = [statistics(pooled([associate(src.truths, twin_detections(src, sensor, seed)) for src in sources]))
-            for seed in range(seeds)]
+def twin_statistics(sources: Sequence[Source], sensor: dict, seeds: int, bar=None) -> dict:
+    """`statistics` of the twin's detections on these sequences, the mean over `seeds` runs (`bar`: a progress bar
+    to move on a run at a time)."""
+    runs = []
+    for seed in range(seeds):
+        if bar is not None:
+            bar.set_description(f"twin run {seed + 1} of {seeds}")
+        runs.append(statistics(pooled([associate(src.truths, twin_detections(src, sensor, seed)) for src in sources])))
+        if bar is not None:
+            bar.update()
     with np.errstate(invalid="ignore"):
         return {k: float(np.mean([r[k] for r in runs])) for k in runs[0]}
 
@@ -418,14 +428,29 @@ class Calibration:
     detections: int
 
 
-def calibrate(folders: Sequence[str | Path], seeds: int = 3) -> Calibration:
+def calibrate(folders: Sequence[str | Path], seeds: int = 3, progress: bool = False) -> Calibration:
     """Fit the detector on every folder's detections together, and check it: the twin's statistics are the mean over
-    `seeds` runs of the fitted detector on the same people."""
-    sources = [read(f) for f in folders]
-    together = pooled([src.associated for src in sources])
-    sensor = fit(together)
-    return Calibration(sensor, statistics(together), twin_statistics(sources, sensor, seeds),
-                       tuple(str(f) for f in folders), len(together.frame), len(together.det_frame))
+    `seeds` runs of the fitted detector on the same people. `progress`: a bar on stderr over the folders read, the fit
+    and the twin runs."""
+    from tqdm import tqdm
+
+    with tqdm(total=len(folders) + 1 + seeds, unit="step", leave=False, disable=not progress, delay=1.0) as bar:
+        sources = []
+        for f in folders:
+            bar.set_description(f"reading {Path(f).name}")
+            sources.append(read(f))
+            bar.update()
+        together = pooled([src.associated for src in sources])
+        bar.set_description("fitting the detector")
+        try:
+            sensor = fit(together)
+        except (ValueError, RuntimeError) as err:  # too few or too alike detections for a fit: say whose
+            raise ValueError(f"{', '.join(map(str, folders))}: the detector cannot be fitted to these detections "
+                             f"({err})") from None
+        bar.update()
+        twin = twin_statistics(sources, sensor, seeds, bar)
+    return Calibration(sensor, statistics(together), twin, tuple(str(f) for f in folders), len(together.frame),
+                       len(together.det_frame))
 
 
 def pooled(parts: Sequence[Associated]) -> Associated:

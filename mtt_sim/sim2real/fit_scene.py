@@ -73,7 +73,10 @@ def link_sequence(folder, seed: int = 0) -> tuple[np.ndarray, object]:
             (scratch / "seqinfo.ini").symlink_to((folder / "seqinfo.ini").resolve())
         with warnings.catch_warnings():  # unscored without gt/, as meant
             warnings.simplefilter("ignore")
-            env = TrackingEnv(scratch, obs_mode="detections")
+            try:
+                env = TrackingEnv(scratch, obs_mode="detections")
+            except ValueError as err:  # a bad file named where the user has it, not in the scratch folder
+                raise type(err)(str(err).replace(str(scratch), str(folder))) from None
         info = env.source.info  # named by seqinfo.ini, else after the scratch folder: then after the sequence's
         if not (folder / "seqinfo.ini").is_file():
             info = dataclasses.replace(info, name=folder.name)
@@ -200,6 +203,9 @@ def fit_scene(folder, sensor=None, seeds=(0, 1)) -> tuple[dict, dict, dict, str]
     """Fit a scene to a sequence folder's detections: (the scene as a mapping with the sensor merged in, the
     sequence's statistics, the scene's statistics over `seeds`, the TOML text with its header)."""
     rows, info = link_sequence(folder)
+    if not len(rows):
+        raise scn.ConfigError(f"{folder}: no tracklets of {MIN_FRAMES} frames or more in its det/det.txt to fit a "
+                              "scene to")
     raw = with_sensor(fit(rows, info), sensor)
     scn.from_mapping(raw, f"scene fitted to {folder}")
     real = statistics(rows, info.length, info.height)
