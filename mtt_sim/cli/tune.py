@@ -6,8 +6,9 @@ import argparse
 import json
 from pathlib import Path
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, add_overrides, episode_overrides, integer,
-                                   loaded, output_file, parse_seeds, replaced, require, scenario_keys, tracker_spec)
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, UsageError, add_dry_run, add_overrides, dry_run,
+                                   episode_overrides, estimate, integer, loaded, output_file, parse_seeds, replaced,
+                                   require, scenario_keys, tracker_spec)
 
 
 def metric_goals(text: str) -> str:
@@ -48,6 +49,7 @@ def add(subparsers) -> None:
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     add_overrides(p, CONFIG_HELP)
+    add_dry_run(p)
     p.set_defaults(func=run)
 
 
@@ -59,6 +61,13 @@ def run(args) -> int:
     plot = output_file(args.plot, args.force, "--plot", (".png",))
     if plot:
         require("matplotlib", "--plot", "plot")
+    if args.backend == "ray":
+        require("ray", "--backend", "ray")
+    elif args.address:
+        raise UsageError("--address", f"{args.address!r}: a Ray cluster's address goes with --backend ray")
+    trials = [(args.trials, "trials"), (len(args.on), "sources"), (len(args.seeds), "seeds")]
+    if dry_run(args, estimate("tune", trials, args.on, overrides), announce=True):
+        return 0
     from mtt_sim.lab import tune
 
     result, study = tune.tune(args.spec, args.on, args.metric, args.trials, args.seeds, overrides, args.seed,
