@@ -37,7 +37,7 @@ def test_searched_keys_are_checked_against_the_keys_own_ranges_and_choices():
     for text, message in [("sensor.pd=0.5:1.5", r"within the key's range 0.0..1.0"),
                           ("sensor.pd=0.9:0.5", "LO < HI"), ("sensor.pd=0.5", "float bounds"),
                           ("groups.0.count=2.5:9", "int bounds"), ("render.camera=static|zoom", "'zoom' is not one of render.camera's choices"),
-                          ("render.camera=static|shkae", r"'shkae' .* \(did you mean 'shake'\?\); allowed: static\\|pan"),
+                          ("render.camera=static|shkae", r"'shkae' .* \(did you mean 'shake'\?\); allowed: static\|pan"),
                           ("render.camera=shake", "two or more of"), ("groups.0.name", "without a list of choices"),
                           ("sensor.ppd=0:1", "no key sensor.ppd")]:
         with pytest.raises(ConfigError, match=message):
