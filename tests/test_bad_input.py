@@ -65,9 +65,9 @@ BAD_INPUTS = [
     (["trackers", "nowhere.py:Cls"], r"tracker nowhere.py:Cls: no such file 'nowhere.py'"),
     # run: files named with their row or key
     (["run", "OK", "--tracker", "learned:policy=BADNPZ"], r"argument --tracker: policy file \S*bad.npz: not a policy"),
-    (["run", "FEWCOLS"], r"fewcols/det/det.txt: row 1 has 5 comma-separated values, '1,-1,10,10,20'"),
+    (["run", "FEWCOLS"], r"fewcols/det/det.txt: row 1 has 5 values, '1,-1,10,10,20'"),
     (["run", "NONNUM"], r"nonnum/det/det.txt: row 2: 'x' is not a number"),
-    (["run", "GTBAD"], r"gtbad/gt/gt.txt: row 2 has 4 comma-separated values"),
+    (["run", "GTBAD"], r"gtbad/gt/gt.txt: row 2 has 4 values"),
     (["run", "NOFR"], r"nofr/seqinfo.ini: \[Sequence\] has no frameRate"),
     (["run", "NOWIDTH"], r"nowidth/seqinfo.ini: \[Sequence\] has no imWidth"),
     (["run", "NOSECTION"], r"nosection/seqinfo.ini: not an INI file with a \[Sequence\] section"),
@@ -136,7 +136,7 @@ BAD_INPUTS = [
     (["fit-scene", "OK", "--sensor", "BADSENSOR", "--out", "s.toml"], r"argument --sensor: \S*badsensor.toml: unknown "
                                                                       r"key sensor.pdd"),
     (["fit-scene", "FEWCOLS", "--sensor", "SENSOR", "--out", "s.toml"],
-     r"argument DIR: \S*/fewcols/det/det.txt: row 1 has 5 comma-separated values"),  # the folder given, no scratch one
+     r"argument DIR: \S*/fewcols/det/det.txt: row 1 has 5 values"),  # the folder given, no scratch one
     (["fit-scene", "OK", "--sensor", "SENSOR", "--out", "s.txt"], r"argument --out: 's.txt': the file name must end in"),
     (["fit-scene", "nowhere", "--sensor", "SENSOR", "--out", "s.toml"], r"argument DIR: 'nowhere' is not a sequence "),
     # learn-policy
@@ -160,9 +160,9 @@ BAD_INPUTS = [
     (["export", "EMPTYDET", "--out", "seq"], r"emptydet/det/det.txt: no detection rows"),
     (["export", "crossing", "--out", "seq", "--config", "sensor.pd=2"], r"argument --config: .*sensor.pd = 2: out of"),
     # eval
-    (["eval", "--gt", "OK", "--results", "RESULTS_BAD"], r"results_bad.txt: row 2 has 4 comma-separated values"),
+    (["eval", "--gt", "OK", "--results", "RESULTS_BAD"], r"results_bad.txt: row 2 has 4 values"),
     (["eval", "--gt", "OK", "--results", "RESULTS_NONNUM"], r"results_nonnum.txt: row 2: 'y' is not a number"),
-    (["eval", "--gt", "GTBAD", "--results", "RESULTS_OK"], r"gtbad/gt/gt.txt: row 2 has 4 comma-separated values"),
+    (["eval", "--gt", "GTBAD", "--results", "RESULTS_OK"], r"gtbad/gt/gt.txt: row 2 has 4 values"),
     (["eval", "--gt", "OK", "--results", "RESULTS_OK", "--similarity", "giou"], r"argument --similarity: invalid "
                                                                                  r"choice: 'giou'"),
     # check-real
@@ -176,7 +176,7 @@ BAD_INPUTS = [
     (["calibrate", "OK", "--out", "s.toml", "--seeds", "0"], r"argument --seeds: must be an integer >= 1, got '0'"),
     (["validate", "EMPTYDET", "OK"], r"argument DIR: '\S*emptydet/det/det.txt' has no rows"),
     (["validate", "OK", "OK2", "--trackers", "sortt"], r"argument --trackers: unknown tracker 'sortt' \(did you mean"),
-    (["validate", "GTBAD", "OK"], r"argument DIR: \S*gtbad/gt/gt.txt: row 2 has 4 comma-separated values"),
+    (["validate", "GTBAD", "OK"], r"argument DIR: \S*gtbad/gt/gt.txt: row 2 has 4 values"),
     # docs, config
     (["docs", "--out", "/nowhere/site"], r"argument --out: '/nowhere/site': folder '/nowhere' does not exist"),
     (["docs", "--out", "SITE"], r"argument --out: '\S*site' exists and is not empty; add --force"),

@@ -287,8 +287,8 @@ def read_rows(path: str | Path, min_columns: int) -> np.ndarray:
     for number, line in enumerate(text.splitlines(), 1):
         values = line.replace(" ", "").split(",")
         if len(values) < min_columns:
-            raise ValueError(f"{path}: row {number} has {len(values)} comma-separated values, {line.strip()!r}; every "
-                             f"row needs at least {min_columns} (frame, id, x, y, w, h, ...)")
+            raise ValueError(f"{path}: row {number} has {len(values)} values, {line.strip()!r}; every row needs at "
+                             f"least {min_columns} comma-separated values (frame, id, x, y, w, h, ...)")
         try:
             rows.append([float(v) for v in values])
         except ValueError:
