@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, UsageError, add_dry_run, add_overrides, dry_run,
-                                   episode_overrides, estimate, integer, loaded, output_file, parse_seeds, replaced,
-                                   require, scenario_keys, tracker_spec)
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
+                                   dry_run, episode_overrides, estimate, integer, loaded, output_file, parse_seeds,
+                                   replaced, require, scenario_keys, tracker_spec)
 
 
 def metric_goals(text: str) -> str:
@@ -31,7 +32,8 @@ def add(subparsers) -> None:
     p.add_argument("--metric", type=metric_goals, default="HOTA",
                    help="what to optimise (default HOTA); several for a Pareto front, e.g. HOTA,-IDSW (counts of "
                         "errors and distances are minimised unless marked +)")
-    p.add_argument("--trials", type=integer(1), default=50, help="trials in all, the defaults' first (default 50)")
+    p.add_argument("--trials", type=integer(1), default=50,
+                   help="finished trials in all, the defaults' first; an interrupted one does not count (default 50)")
     p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1"),
                    help="episode seeds per source: a count (3: seeds 0..2), a list or a range (default 1)")
     p.add_argument("--seed", type=integer(0), default=0, help="the sampler's seed: one seed, one study (default 0)")
@@ -40,8 +42,10 @@ def add(subparsers) -> None:
                    help="local processes, or Ray tasks for a trial's episodes (the [ray] extra; --address for a cluster)")
     p.add_argument("--address", help="with --backend ray: a Ray cluster's address")
     p.add_argument("--storage", help="an Optuna storage URL, e.g. sqlite:///study.db: the study is kept there and "
-                                     "resumed by the same command")
-    p.add_argument("--study-name", help="the study's name in --storage (default: the tracker and the sources)")
+                                     "resumed by the same command (interrupted trials rerun first)")
+    p.add_argument("--study-name", help="the study's name in --storage (default: the tracker, the sources, the metric "
+                                        "and a digest of all that defines the tuning); a stored study made for "
+                                        "another tuning is refused")
     p.add_argument("--time-budget", type=integer(1), metavar="SECONDS", help="stop starting trials after this long")
     p.add_argument("--out", help="write the result as TOML: the spec, its score, the defaults' and the parameters")
     p.add_argument("--plot", help="write the optimisation history as a PNG, and the parameters' importances beside "
@@ -70,19 +74,38 @@ def run(args) -> int:
         return 0
     from mtt_sim.lab import tune
 
-    result, study = tune.tune(args.spec, args.on, args.metric, args.trials, args.seeds, overrides, args.seed,
-                              args.workers, args.storage, args.study_name, args.time_budget, progress=not args.json,
-                              backend=args.backend, address=args.address)
+    try:
+        result, study = tune.tune(args.spec, args.on, args.metric, args.trials, args.seeds, overrides, args.seed,
+                                  args.workers, args.storage, args.study_name, args.time_budget,
+                                  progress=not args.json, backend=args.backend, address=args.address,
+                                  say=lambda line: print(line, file=sys.stderr))
+    except tune.Interrupted as stop:  # Ctrl-C or SIGTERM: the trial in flight marked interrupted, the best so far
+        if stop.result is None:
+            print("mtt-sim tune: interrupted before any trial finished" + _resume(args, stop.study.study_name),
+                  file=sys.stderr)
+            return INTERRUPTED
+        result, study = stop.result, stop.study
     if out:
         out.write_text(result.toml())
     if plot:
         tune.plot(study, result.goals, plot)
     if args.json:
         print(json.dumps(result.as_dict()))
-        return 0
-    print(tune.report(result, study))
-    for path, what in ((out, "result"), (plot, "plots")):
-        if path:
-            print(f"{what}: {path}" + (f" and {Path(path).stem}_importances.png" if what == "plots" else "")
-                  + replaced(args.force))
+    else:
+        print(tune.report(result, study))
+        for path, what in ((out, "result"), (plot, "plots")):
+            if path:
+                print(f"{what}: {path}" + (f" and {Path(path).stem}_importances.png" if what == "plots" else "")
+                      + replaced(args.force))
+    if result.interrupted:
+        print(f"mtt-sim tune: interrupted; {result.finished} of {result.wanted} trials finished"
+              + _resume(args, result.study), file=sys.stderr)
+        return INTERRUPTED
     return 0
+
+
+def _resume(args, study: str) -> str:
+    """How an interrupted study goes on: the same command, where --storage keeps it."""
+    if args.storage:
+        return f"; the same command resumes study {study!r}"
+    return "; the study was in memory only (--storage keeps one to resume)"
