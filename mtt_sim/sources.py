@@ -80,6 +80,9 @@ def open_source(what: str | os.PathLike | Scenario, overrides: Mapping | None = 
         from mtt_sim.real.sequence import Recording
 
         recording = Recording(what, benchmark, overrides)
+        if recording.scored and not recording.truth_rows:
+            raise ConfigError(f"{Path(what) / 'gt' / 'gt.txt'}: no rows: nothing to score against, and nobody for a "
+                              "twin to detect (remove the file to replay the sequence unscored)")
         if recording.config.sensor.model == "recorded" and not recording.detection_rows:
             det = Path(what) / "det" / "det.txt"
             raise ConfigError(f"{det}: " + ("no detection rows" if det.is_file() else "not found")

@@ -84,6 +84,7 @@ BAD_INPUTS = [
     (["run", "crossing", "--detector", "recorded"], r"argument --config: .*sensor.model = 'recorded' replays"),
     (["run", "OK", "--detector", "foreground"], r"argument --config: \S*ok: sensor.model = 'foreground' needs frames"),
     (["run", "OK", "--config", "sensor.pd=0.5"], r"argument --config: \S*ok: sensor.pd applies to the synthetic"),
+    (["run", "crossing", "--scale", "2"], r"argument --scale: 2: enlarges the video's frames; give --video too"),
     # bench
     (["bench", "--scenarios", "EMPTYDET", "--trackers", "sort"], r"emptydet/det/det.txt: no detection rows"),
     ([*["bench", *CROSSING], "--address", "x"], r"argument --address: 'x': a Ray cluster's address goes with --backend"),
@@ -93,6 +94,9 @@ BAD_INPUTS = [
     (["bench", "--scenarios", "crossing,CROSSING", "--trackers", "sort"], r"'crossing,CROSSING': expected distinct"),
     ([*["bench", *CROSSING], "--plot", "p.jpg"], r"argument --plot: 'p.jpg': the file name must end in \.png"),
     ([*["bench", *CROSSING], "--results-dir", "/nowhere/x"], r"argument --results-dir: '/nowhere/x': folder '/nowhere'"),
+    ([*["bench", *CROSSING], "--seeds", "0-99999999"], r"argument --seeds: '0-99999999': at most 100000 seeds"),
+    (["bench", "--scenarios", "books,crossing", "--trackers", "ipf", "--by", "target", "--metric", "CentreError"],
+     r"argument --scenarios: books,crossing: --by target makes a column per ground-truth id of one scenario"),
     # sweep
     (["sweep", "crossing", "--param", "sensor.pd=0.5,0.5", "--trackers", "sort"],
      r"argument --param: 'sensor.pd=0.5,0.5': the value 0.5 is given twice"),
@@ -163,6 +167,9 @@ BAD_INPUTS = [
     (["eval", "--gt", "OK", "--results", "RESULTS_BAD"], r"results_bad.txt: row 2 has 4 values"),
     (["eval", "--gt", "OK", "--results", "RESULTS_NONNUM"], r"results_nonnum.txt: row 2: 'y' is not a number"),
     (["eval", "--gt", "GTBAD", "--results", "RESULTS_OK"], r"gtbad/gt/gt.txt: row 2 has 4 values"),
+    (["eval", "--gt", "EMPTYGT", "--results", "RESULTS_OK"], r"emptygt/gt/gt.txt: no rows: there is no ground truth"),
+    (["run", "EMPTYGT"], r"emptygt/gt/gt.txt: no rows: nothing to score against"),
+    (["tune", "sort", "--on", "EMPTYGT", "--detector", "synthetic"], r"emptygt/gt/gt.txt: no rows: nothing to score"),
     (["eval", "--gt", "OK", "--results", "RESULTS_OK", "--similarity", "giou"], r"argument --similarity: invalid "
                                                                                  r"choice: 'giou'"),
     # check-real

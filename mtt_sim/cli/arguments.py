@@ -26,6 +26,7 @@ from mtt_sim.sim.config import SensorConfig, table
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
                 "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
                 "num_gt_ids")
+MAX_SEEDS = 100_000  # more is a typo (0-99999999), not a grid anyone means to run
 INTERRUPTED = 130  # the shell's status for a command stopped by Ctrl-C (SIGTERM is treated the same way)
 SCENARIO_HELP = ("scenario key (see `mtt-sim list`, any case), env id (mtt_sim/Crossing-v0), .toml file or a "
                  "MOTChallenge sequence folder")
@@ -95,6 +96,8 @@ def parse_seeds(text: str) -> list[int]:
             count = int(text)
             if count < 1:
                 raise ValueError
+            if count > MAX_SEEDS:
+                raise OverflowError
             return list(range(count))
         seeds = []
         for item in text.split(","):
@@ -102,7 +105,11 @@ def parse_seeds(text: str) -> list[int]:
             lo, hi = int(first), int(last) if sep else int(first)
             if lo < 0 or hi < lo:
                 raise ValueError
+            if len(seeds) + hi - lo + 1 > MAX_SEEDS:
+                raise OverflowError
             seeds += range(lo, hi + 1)
+    except OverflowError:
+        raise argparse.ArgumentTypeError(f"{text!r}: at most {MAX_SEEDS} seeds") from None
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r}: expected a count of at least 1 (5: seeds 0..4), a list (3,7,11) or "
                                          "a range (100-199) of seeds >= 0") from None

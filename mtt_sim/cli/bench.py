@@ -23,6 +23,9 @@ def run(args) -> int:
     loaded(args.scenarios, overrides)
     if args.by == "target" and set(args.metric) - set(PER_TARGET):
         raise UsageError("--metric", f"with --by target: {', '.join(PER_TARGET)} (per-target metrics)")
+    if args.by == "target" and len(args.scenarios) > 1:
+        raise UsageError("--scenarios", f"{','.join(args.scenarios)}: --by target makes a column per ground-truth id "
+                                        "of one scenario; give one")
     title = ",".join(args.scenarios) if args.by == "target" else ""
     grid.check_plot(args)
     if args.plot and args.by == "target":

@@ -32,10 +32,7 @@ def run(args) -> int:
     from mtt_sim.real import motchallenge
 
     if args.dry_run:  # the files read and checked as the scoring reads them, nothing scored
-        from mtt_sim.real.sequence import Recording, check_frames, read_rows
-
-        recording = Recording(args.gt, args.benchmark)
-        check_frames(Path(args.results), read_rows(args.results, 6), len(recording))
+        recording, _ = motchallenge.read_scored(args.gt, args.results, args.benchmark)
         dry_run(args, estimate("eval", [(len(recording), "frames scored")], unit="frames scored"))
         return 0
     s = scenario.ScoringConfig()

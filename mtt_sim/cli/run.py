@@ -39,6 +39,8 @@ def run(args) -> int:
     results = output_file(args.results, args.force, "--results", (".txt",))
     if args.compare and args.results:
         raise UsageError("--results", "a results file takes one tracker: leave out --compare")
+    if args.scale != 1 and not args.video:
+        raise UsageError("--scale", f"{args.scale}: enlarges the video's frames; give --video too")
     specs = args.compare or [args.tracker]
     if dry_run(args, estimate("run", [(len(specs), "trackers"), (1, "seeds")], [args.scenario], overrides,
                               steps=args.steps)):

@@ -34,16 +34,24 @@ def per_frame(rows: np.ndarray, frames: int) -> list[tuple[np.ndarray, np.ndarra
 def evaluate_results(sequence_folder: str | Path, results: str | Path, benchmark: str | None = None, **scoring) -> dict:
     """Our metrics of a results file against a sequence's ground truth, scored as TrackEval scores the sequence's
     benchmark (see `mtt_sim.real.sequence`): the same numbers the env gives for the same tracks."""
-    recording = Recording(sequence_folder, benchmark)
-    if not recording.scored:
-        raise FileNotFoundError(f"{Path(sequence_folder) / 'gt' / 'gt.txt'}: not found; there is no ground truth to score")
-    rows = read_rows(results, 6)
-    check_frames(Path(results), rows, len(recording))
+    recording, rows = read_scored(sequence_folder, results, benchmark)
     metrics = EpisodeMetrics(**scoring)
     for k, (ids, boxes) in enumerate(per_frame(rows, len(recording))):
         gt_ids, gt_boxes, scored = recording.scoring(k, boxes)
         metrics.update(gt_ids, gt_boxes, ids[scored], boxes[scored])
     return metrics.summary()
+
+
+def read_scored(sequence_folder: str | Path, results: str | Path, benchmark: str | None = None):
+    """The sequence with its ground truth and the results file's rows, each checked (a clear error naming the file)."""
+    recording = Recording(sequence_folder, benchmark)
+    if not recording.scored:
+        raise FileNotFoundError(f"{Path(sequence_folder) / 'gt' / 'gt.txt'}: not found; there is no ground truth to score")
+    if not recording.truth_rows:
+        raise ValueError(f"{Path(sequence_folder) / 'gt' / 'gt.txt'}: no rows: there is no ground truth to score")
+    rows = read_rows(results, 6)
+    check_frames(Path(results), rows, len(recording))
+    return recording, rows
 
 
 def write_results(path: str | Path, tracks_per_frame) -> None:

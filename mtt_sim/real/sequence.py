@@ -95,6 +95,7 @@ class Recording:
         counts = np.diff(self._det[1])
         self.max_detections = int(counts.max()) if len(counts) else 0
         self.detection_rows = len(det)  # none: nothing to replay as recorded (open_source refuses it)
+        self.truth_rows = 0 if gt is None else len(gt)  # none in a gt.txt: nothing to score (refused where scored)
         self.det_range = (det[:, 2:7].min(axis=0), det[:, 2:7].max(axis=0)) if len(det) else (np.zeros(5), np.zeros(5))
         self.config = self._configure(overrides or {})
         self.image_size = (self.info.width, self.info.height)
