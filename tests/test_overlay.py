@@ -141,3 +141,30 @@ def test_render_draws_on_a_copy_and_the_observed_frame_stays_as_it_was():
     assert img.shape == before.shape and not np.array_equal(img, before)
     banner = img[:20, :300].reshape(-1, 3)
     assert (banner.max(axis=1) > 200).sum() > 200  # the banner's text is there, and readable (white)
+
+
+def test_a_gif_keeps_the_overlay_s_colours_exactly(tmp_path):
+    """A GIF has 64 colours: the overlay's few pixels keep theirs instead of merging into a noisy backdrop's."""
+    import imageio.v3 as iio
+
+    from mtt_sim.show.video import RESERVED, VideoWriter, gif_palette
+
+    rng = np.random.default_rng(0)
+    frames = []
+    for k in range(4):
+        img = np.clip(rng.normal(140, 30, (120, 160, 3)), 0, 255).astype(np.uint8)
+        img[40:90, 100:130] = (180, 170, 60)  # a signboard
+        for j, colour in enumerate((GT_COLOR, DET_COLOR, *TRACK_PALETTE)):
+            img[10 + 10 * j, 5 + k: 60 + k] = colour  # one-pixel lines, moving
+        frames.append(img)
+    path = tmp_path / "lines.gif"
+    with VideoWriter(path, fps=2) as writer:
+        for img in frames:
+            writer.write(img)
+    back = iio.imread(path, index=None)[..., :3]
+    for j, colour in enumerate((GT_COLOR, DET_COLOR, *TRACK_PALETTE)):
+        assert (back[0, 10 + 10 * j, 5:60] == colour).all(), colour
+    assert np.abs(back[0, 45:85, 105:125].astype(int) - (180, 170, 60)).max() <= 30  # the signboard stays yellow
+    palette = gif_palette(frames[0])
+    assert len(palette) == 64 and [tuple(c) for c in palette[: len(RESERVED)]] == list(RESERVED)
+    np.testing.assert_array_equal(gif_palette(frames[0]), palette)  # the same frame, the same palette
