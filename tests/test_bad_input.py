@@ -93,6 +93,7 @@ BAD_INPUTS = [
      r"argument --config: .*unknown key sensor.pdd \(did you mean sensor.pd\?\)"),
     (["bench", "--scenarios", "crossing,CROSSING", "--trackers", "sort"], r"'crossing,CROSSING': expected distinct"),
     ([*["bench", *CROSSING], "--plot", "p.jpg"], r"argument --plot: 'p.jpg': the file name must end in \.png"),
+    ([*["bench", *CROSSING], "--metric", "MOTA,mota"], r"argument --metric: 'MOTA,mota': expected one or more distinct"),
     ([*["bench", *CROSSING], "--results-dir", "/nowhere/x"], r"argument --results-dir: '/nowhere/x': folder '/nowhere'"),
     ([*["bench", *CROSSING], "--seeds", "0-99999999"], r"argument --seeds: '0-99999999': at most 100000 seeds"),
     (["bench", "--scenarios", "books,crossing", "--trackers", "ipf", "--by", "target", "--metric", "CentreError"],
@@ -122,6 +123,7 @@ BAD_INPUTS = [
     (["stress", "sort", "--scenario", "crossing", "--vary", "render.camera"],
      r"argument --vary: render.camera=pan makes no valid scene: .*needs a static or shaking camera"),
     ([*["stress", *VARY], "--budget", "0"], r"argument --budget: must be an integer >= 1, got '0'"),
+    ([*["stress", *VARY], "--config", "sensor.pd=2"], r"argument --config: .*sensor.pd = 2: out of range"),
     ([*["stress", *VARY], "--objective", "MOTA[sortt]"], r"argument --objective: unknown tracker 'sortt' \(did you "),
     (["stress", "sort", "--scenario", "TYPO", "--vary", "sensor.pd=0.5:0.9"],
      r"argument --scenario: \S*typo.toml: unknown key sensor.clutter_rat"),
@@ -184,12 +186,15 @@ BAD_INPUTS = [
     (["validate", "EMPTYDET", "OK"], r"argument DIR: '\S*emptydet/det/det.txt' has no rows"),
     (["validate", "OK", "OK2", "--trackers", "sortt"], r"argument --trackers: unknown tracker 'sortt' \(did you mean"),
     (["validate", "GTBAD", "OK"], r"argument DIR: \S*gtbad/gt/gt.txt: row 2 has 4 values"),
+    (["validate", "OK", "OK2", "OK"], r"argument DIR: '\S*ok' is given twice; give each sequence once"),
+    (["calibrate", "OK", "OK", "--out", "s.toml"], r"argument DIR: '\S*ok' is given twice"),
     # docs, config
     (["docs", "--out", "/nowhere/site"], r"argument --out: '/nowhere/site': folder '/nowhere' does not exist"),
     (["docs", "--out", "SITE"], r"argument --out: '\S*site' exists and is not empty; add --force"),
     (["config", "crossing", "--sensor", "BADSENSOR"], r"argument --sensor: \S*badsensor.toml: unknown key sensor.pdd"),
     (["config", "TYPO"], r"argument scenario: \S*typo.toml: unknown key sensor.clutter_rat"),
     (["config", "socer"], r"argument scenario: unknown scenario 'socer' \(did you mean 'soccer'\?\)"),
+    (["config", "--detector", "synthetic"], r"argument --detector: 'synthetic': overrides apply to a scenario"),
 ]
 
 

@@ -182,6 +182,17 @@ def calibration_folder(text: str) -> str:
     return text
 
 
+def distinct_folders(folders: list[str], argument: str = "DIR") -> None:
+    """Each sequence folder once (a folder given twice would count its data twice)."""
+    seen = {}
+    for folder in folders:
+        key = os.path.realpath(folder)
+        if key in seen:
+            raise UsageError(argument, f"{folder!r} is given twice" + (f" (as {seen[key]!r} too)" if seen[key] != folder
+                                                                       else "") + "; give each sequence once")
+        seen[key] = folder
+
+
 def rows_in(path: Path, argument: str) -> None:
     """A MOTChallenge file with at least one row, or an ArgumentTypeError naming it."""
     try:
@@ -218,6 +229,8 @@ def metric_names(text: str) -> list[str]:
             raise argparse.ArgumentTypeError(f"unknown metric {typed!r}" + (f" (did you mean {names[near[0]]!r}?)"
                                              if near else "") + f"; available: {', '.join(names.values())}")
         out.append(names[typed.lower()])
+    if not out or len(set(out)) != len(out):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected one or more distinct metrics, e.g. MOTA,IDF1")
     return out
 
 

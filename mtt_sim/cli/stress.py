@@ -9,8 +9,8 @@ import sys
 
 from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
-                                   dry_run, episode_overrides, estimate, integer, output_folder, parse_seeds, replaced,
-                                   require, scenario_key, tracker_spec)
+                                   dry_run, episode_overrides, estimate, integer, loaded, output_folder, parse_seeds,
+                                   replaced, require, scenario_key, tracker_spec)
 
 SAMPLERS = ("tpe", "cmaes", "random")
 
@@ -81,6 +81,7 @@ def add(subparsers) -> None:
 def run(args) -> int:
     require("optuna", "stress", "tune")
     overrides = episode_overrides(args)
+    loaded([args.scenario], overrides)
     out = output_folder(args.out, resuming.force(args, args.out, "--out"), "--out", "write into it") if args.out else None
     if out:
         require("matplotlib", "--out", "plot")

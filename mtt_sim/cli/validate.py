@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, dry_run, estimate, integer, output_file,
-                                   replaced, tracker_specs)
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, distinct_folders, dry_run, estimate,
+                                   integer, output_file, replaced, tracker_specs)
 
 
 def add(subparsers) -> None:
@@ -22,6 +22,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
+    distinct_folders(args.folders)
     out = output_file(args.out, args.force, "--out", (".md",))
     from mtt_sim.sim2real import validate
 
