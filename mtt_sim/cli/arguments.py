@@ -396,6 +396,11 @@ def _noun(n: int, plural: str) -> str:
     return plural[:-1] if n == 1 and plural.endswith("s") else plural
 
 
+def announce(line: str) -> None:
+    """The estimate of a long run, on stderr as it starts (stdout and --json stay clean)."""
+    print(line, file=sys.stderr, flush=True)
+
+
 def dry_run(args, line: str, announce: bool = False) -> bool:
     """The estimate `line`: with --dry-run printed (stdout) and True, the command stops there; otherwise printed on
     stderr where `announce` (a long run says what it is about to do; stdout and --json stay clean) and False."""

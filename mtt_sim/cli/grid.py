@@ -9,9 +9,9 @@ import shlex
 import sys
 
 from mtt_sim.cli import resuming
-from mtt_sim.cli.arguments import (FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides, dry_run, estimate,
-                                   integer, metric_names, output_file, output_folder, parse_seeds, replaced, require,
-                                   tracker_specs)
+from mtt_sim.cli.arguments import (FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides, announce, dry_run,
+                                   estimate, integer, metric_names, output_file, output_folder, parse_seeds, replaced,
+                                   require, tracker_specs)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -59,8 +59,9 @@ def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> in
     elif args.address:
         raise UsageError("--address", f"{args.address!r}: a Ray cluster's address goes with --backend ray")
     columns = (len(configs), "values") if configs else (len(scenarios), "scenarios")
-    if dry_run(args, estimate(args.command, [(len(args.trackers), "trackers"), columns, (len(args.seeds), "seeds")],
-                              scenarios, overrides, configs or ({},)), announce=True):
+    work = estimate(args.command, [(len(args.trackers), "trackers"), columns, (len(args.seeds), "seeds")], scenarios,
+                    overrides, configs or ({},))
+    if dry_run(args, work):
         return 0
     from mtt_sim.lab import experiment
 
@@ -68,6 +69,7 @@ def run(args, scenarios: list[str], overrides: dict, configs, table, plot) -> in
     definition = {"command": args.command, "trackers": args.trackers, "scenarios": scenarios, "seeds": list(args.seeds),
                   "config": overrides, "configs": configs, "results_dir": args.results_dir}
     journal = resuming.journal(out, definition, args.resume, "episodes") if out else None
+    announce(work)
     record_file = experiment.RecordFile(out) if out else None
 
     def keep(record):

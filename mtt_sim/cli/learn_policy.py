@@ -16,6 +16,7 @@ from mtt_sim.cli.arguments import (
     UsageError,
     add_dry_run,
     add_overrides,
+    announce,
     dry_run,
     episode_overrides,
     estimate,
@@ -87,12 +88,14 @@ def run(args) -> int:
     population = args.population or 4 + int(3 * math.log(30))  # CMA-ES's own for the policy's 30 weights
     work_done = [(args.generations, "generations"), (population, "policies"), (len(args.on), "sources"),
                  (len(args.seeds), "seeds")]
-    if dry_run(args, estimate("learn-policy", work_done, args.on, overrides, steps=args.frames), announce=True):
+    work_line = estimate("learn-policy", work_done, args.on, overrides, steps=args.frames)
+    if dry_run(args, work_line):
         return 0
     definition = {"command": "learn-policy", "on": args.on, "seeds": list(args.seeds), "frames": args.frames,
                   "base": args.base, "population": args.population, "sigma": args.sigma, "metrics": metrics,
                   "seed": args.seed, "config": overrides}  # not --generations: a resumed search may go on for more
     journal = resuming.journal(out, definition, args.resume, "episodes")
+    announce(work_line)
     work = Path(f"{out}.work")  # the training episodes and the policies tried, until the search ends
     try:
         learning = learn_policy(args.on, args.seeds, args.generations, args.population, args.sigma, args.seed,

@@ -9,7 +9,7 @@ import sys
 
 from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
-                                   dry_run, episode_overrides, estimate, integer, loaded, output_folder, parse_seeds,
+                                   announce, dry_run, episode_overrides, estimate, integer, loaded, output_folder, parse_seeds,
                                    replaced, require, scenario_key, tracker_spec)
 
 SAMPLERS = ("tpe", "cmaes", "random")
@@ -98,13 +98,15 @@ def run(args) -> int:
         raise UsageError("--objective", str(err)) from None
     scenes = [(args.budget * (2 if args.against_random else 1), "scenes"), (len(args.seeds), "seeds"),
               (len(objective.specs), "trackers")]
-    if dry_run(args, estimate("stress", scenes, [args.scenario], overrides), announce=True):
+    work = estimate("stress", scenes, [args.scenario], overrides)
+    if dry_run(args, work):
         return 0
 
     definition = {"command": "stress", "spec": args.spec, "scenario": args.scenario, "objective": args.objective,
                   "vary": [d.text() for d in args.vary], "budget": args.budget, "seeds": list(args.seeds),
                   "seed": args.seed, "sampler": args.sampler, "against_random": args.against_random, "config": overrides}
     journal = resuming.journal(out, definition, args.resume, "episodes") if out else None
+    announce(work)
 
     def searched(sampler: str) -> stress.Search:
         return stress.search(args.spec, args.scenario, args.vary, args.objective, args.budget, args.seeds,
