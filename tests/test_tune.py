@@ -19,6 +19,7 @@ import pytest
 from mtt_sim import cli, trackers
 from mtt_sim.lab import tune
 from mtt_sim.lab.experiment import run_episode
+from mtt_sim.lab.study import default_study_name, definition
 from mtt_sim.metrics.goals import Goal, goals
 from mtt_sim.trackers.base import parse_spec, spec_of
 
@@ -148,7 +149,7 @@ def test_a_stored_study_refuses_another_definition_under_its_name_before_any_tri
         message = str(refused.value)
         assert f"; {field}: was " in message or f"({field}: was " in message, (field, message)
         assert "\n" not in message and "give another --study-name, or drop --study-name for this tuning's own study " \
-            f"'{tune.default_study_name(args['spec'], args['sources'], args['metric'], tune.definition(**args)[1])}'" \
+            f"'{default_study_name(args['spec'], args['sources'], args['metric'], definition(**args)[1])}'" \
             in message
     with pytest.raises(ValueError, match=r"metric: was 'maximize HOTA', now 'maximize MOTA'\)"):
         tune.tune("sort", ["mot17_like"], "MOTA", trials=3, config=TINY, storage=storage, study_name="s")
@@ -171,24 +172,24 @@ def test_a_study_without_a_stored_definition_is_refused_unless_it_is_empty(tmp_p
         tune.tune("sort", ["mot17_like"], trials=2, config=TINY, storage=storage, study_name="old")
     optuna.create_study(storage=storage, study_name="empty", direction="maximize")
     result, study = tune.tune("sort", ["mot17_like"], trials=1, config=TINY, storage=storage, study_name="empty")
-    assert study.user_attrs["definition"] == tune.definition("sort", ["mot17_like"], "HOTA", [0], TINY)[0]
+    assert study.user_attrs["definition"] == definition("sort", ["mot17_like"], "HOTA", [0], TINY)[0]
     optuna.create_study(storage=storage, study_name="down", direction="minimize")
     with pytest.raises(ValueError, match="study 'down' is empty but made to minimize, and this tuning would maximize"):
         tune.tune("sort", ["mot17_like"], trials=1, config=TINY, storage=storage, study_name="down")
 
 
 def test_the_default_study_name_carries_a_digest_of_the_definition(tmp_path, capsys):
-    first, digest = tune.definition("sort", ["mot17_like"], "HOTA", [0], TINY)
-    assert tune.definition("sort", ["mot17_like"], "HOTA", [0], {"env": {"max_steps": 5}}) == (first, digest)
+    first, digest = definition("sort", ["mot17_like"], "HOTA", [0], TINY)
+    assert definition("sort", ["mot17_like"], "HOTA", [0], {"env": {"max_steps": 5}}) == (first, digest)
     for other in (dict(metric="MOTA"), dict(seeds=[1]), dict(config={"env.max_steps": 6}),
                   dict(spec="sort:min_hits=1"), dict(metric="HOTA,-IDSW"), dict(sources=["mot17_like", "crossing"])):
         args = {"spec": "sort", "sources": ["mot17_like"], "metric": "HOTA", "seeds": [0], "config": TINY, **other}
-        assert tune.definition(**args)[1] != digest, other
+        assert definition(**args)[1] != digest, other
     scene = tmp_path / "scene.toml"  # a scene file is named by its content too: an edited scene is another study
     scene.write_text('extends = "mot17_like"\n')
-    before = tune.definition("sort", [str(scene)])[1]
+    before = definition("sort", [str(scene)])[1]
     scene.write_text('extends = "mot17_like"\n[sensor]\npd = 0.8\n')
-    assert tune.definition("sort", [str(scene)])[1] != before
+    assert definition("sort", [str(scene)])[1] != before
     storage = f"sqlite:///{tmp_path / 'study.db'}"
     hota, _ = tune.tune("sort", ["mot17_like"], "HOTA", trials=1, config=TINY, storage=storage)
     mota, _ = tune.tune("sort", ["mot17_like"], "MOTA", trials=1, config=TINY, storage=storage)
@@ -315,3 +316,4 @@ def test_ctrl_c_on_the_command_reports_the_best_so_far_writes_out_and_exits_130(
     err = capsys.readouterr().err
     assert err.splitlines()[-1].startswith("mtt-sim tune: error: study 's' was made for another tuning (metric: was "
                                            "'maximize HOTA', now 'maximize MOTA') and its trials would mix")
+
