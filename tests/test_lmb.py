@@ -311,3 +311,79 @@ def test_reid_restores_the_label_of_a_target_that_was_hidden_long_enough_to_be_f
             break
     m = info["metrics"]
     assert hidden >= 40 and m["IDSW"] == switches and m["num_tracker_ids"] == 1 + switches
+
+
+# ------------------------------------------------------------------ diverged components (issue 37)
+
+# Ends of the search ranges that let a component run away on ETH-Bahnhof (a box at x = -657 in a 640 px image, frame
+# 478: outside the action space, so a tuning trial failed)
+RUNAWAY = dict(reid=False, survival=0.999, extract=0.2, process_noise=0.1, measurement_noise=0.05, gate=0.9999,
+               detection=0.4)
+
+
+def test_a_track_coasting_out_of_the_picture_is_dropped_before_its_box_leaves_the_action_space():
+    """A large, fast target leaves on the left: with RUNAWAY's parameters its track coasts on at r > extract and ran
+    an image beyond the border (reported at x = -658, -718, ...); its component is dropped there instead."""
+    env = TrackingEnv(tiny(render={"width": 640, "height": 480}))
+    lmb = trackers.make("lmb", **RUNAWAY)
+    lmb.reset(INFO)
+    x, reported = 300.0, []
+    for _ in range(30):
+        tracks = lmb.update(obs_of([x, 40, 160, 400, 1.0]) if x > -80 else obs_of())
+        env.validate_action(tracks.to_action(env.action_space))  # raises ActionError outside the action space
+        assert np.isfinite(tracks.boxes).all() and (tracks.boxes[:, 2:] > 0).all()
+        reported += tracks.boxes[:, 0].tolist()
+        assert not lmb_diverged(lmb).any()
+        x -= 60
+    assert min(reported) < -500  # it did coast far out (the guard is not what stopped it before)
+    assert len(lmb.tracks.r) == 0  # and was dropped, not merely left unreported
+
+
+def lmb_diverged(lmb):
+    from mtt_sim.trackers.lmb import diverged
+    return diverged(lmb.tracks.m, lmb.tracks.P, INFO["image_size"])
+
+
+def test_diverged_flags_exactly_the_broken_components():
+    from mtt_sim.trackers.lmb import diverged
+    w, h = INFO["image_size"]
+    good_m = np.array([100.0, 80.0, 30.0, 60.0, 1.0, 0.0, 0.0, 0.0])
+    good_P = np.diag([4.0, 4.0, 4.0, 4.0, 1.0, 1.0, 0.1, 0.1])
+    indefinite = good_P.copy()
+    indefinite[0, 4] = indefinite[4, 0] = 3.0   # positive diagonal, a negative eigenvalue
+    negative = good_P.copy()
+    negative[5, 5] = -1.0
+    cases = [  # (mean changes, covariance, diverged?)
+        ({}, good_P, False),
+        ({0: -w, 1: -h, 2: 2 * w, 3: 2 * h}, good_P, False),    # at the action space's edges
+        ({0: 2 * w, 1: 2 * h}, good_P, False),
+        ({0: np.nan}, good_P, True), ({5: np.inf}, good_P, True),
+        ({}, np.where(np.eye(8, dtype=bool), good_P, np.nan), True),
+        ({}, indefinite, True), ({}, negative, True), ({}, np.zeros((8, 8)), True),
+        ({2: 0.0}, good_P, True), ({3: -5.0}, good_P, True),
+        ({2: 2 * w + 1}, good_P, True), ({3: 1e9}, good_P, True),
+        ({0: -w - 1}, good_P, True), ({1: 2 * h + 0.5}, good_P, True), ({0: 1e300}, good_P, True)]
+    m = np.stack([np.array([changes.get(i, v) for i, v in enumerate(good_m)]) for changes, _, _ in cases])
+    P = np.stack([c for _, c, _ in cases])
+    np.testing.assert_array_equal(diverged(m, P, (w, h)), [d for _, _, d in cases])
+    assert diverged(np.zeros((0, 8)), np.zeros((0, 8, 8)), (w, h)).shape == (0,)
+
+
+def test_a_diverged_component_is_dropped_from_its_track_and_a_track_of_diverged_ones_with_it():
+    """Hand-made: track 1 is healthy, track 2 has a healthy component and one an image beyond the left border, track
+    3 only one far beyond it. After one update track 2 keeps its healthy component alone and track 3 is gone, though
+    their existence stays high."""
+    lmb = trackers.make("lmb", reid=False)
+    lmb.reset(INFO)
+    lmb.update(obs_of([100, 100, 30, 60, 0.9], [400, 100, 30, 60, 0.9]))
+    t = lmb.tracks
+    assert t.label.tolist() == [1, 2]
+    m, P = lmb.noise.birth(np.array([[-2000.0, 100, 30, 60]]))
+    t.add(np.array([0.9]), np.array([3]), m, P)       # track 3, alone and diverged
+    t.track, t.w = np.r_[t.track[:2], 1, 2], np.r_[t.w[0], 0.6, 0.4, t.w[2]]   # track 2: its own and one far off
+    t.m, t.P = np.concatenate([t.m[:2], m, t.m[2:]]), np.concatenate([t.P[:2], P, t.P[2:]])
+    t.r[:] = 0.9
+    tracks = lmb.update(obs_of([101, 100, 30, 60, 0.9], [401, 100, 30, 60, 0.9]))
+    assert t.label.tolist() == [1, 2] and sorted(tracks.ids.tolist()) == [1, 2]
+    assert np.bincount(t.track).tolist() == [1, 1] and np.allclose(t.w, 1.0)
+    assert (t.m[:, 0] > 0).all() and np.isfinite(tracks.boxes).all()

@@ -73,6 +73,43 @@ def cartesian_product(options: list[np.ndarray]) -> np.ndarray:
     return out
 
 
+def diverged(m: np.ndarray, P: np.ndarray, image_size: tuple[float, float]) -> np.ndarray:
+    """(n,) bool: the components (means m (n, 8), covariances P (n, 8, 8)) that no longer describe a box the camera
+    could show, so that no track may report them: a non-finite number in the mean or the covariance, a covariance
+    that is not positive definite, a box with a non-positive width or height or one over two images wide or high, or
+    a corner more than one image beyond the border (the env's action space, which trackers may not import).
+
+    Why it is needed: the noise scales with the box, so at the ends of the search ranges (process noise 0.1, a 0.9999
+    gate, survival 0.999, extract 0.2) a component that took a far detection learns a velocity or a growth rate its
+    wider gate then feeds, and a coasting track can run an image beyond the border or grow to thousands of pixels.
+    The filter's state space is boxes in view (the paper's detection probability is of targets in the image), so such
+    a component is a numerical runaway, not a hypothesis; with ordinary parameters none is ever flagged."""
+    w, h = image_size
+    box = m[:, :4]
+    finite = np.isfinite(m).all(axis=1) & np.isfinite(P).all(axis=(1, 2))
+    with np.errstate(invalid="ignore"):
+        ok = finite & (box[:, 0] >= -w) & (box[:, 0] <= 2 * w) & (box[:, 1] >= -h) & (box[:, 1] <= 2 * h)
+        ok &= (box[:, 2] > 0) & (box[:, 2] <= 2 * w) & (box[:, 3] > 0) & (box[:, 3] <= 2 * h)
+    ok[ok] = _positive_definite(P[ok])
+    return ~ok
+
+
+def _positive_definite(P: np.ndarray) -> np.ndarray:
+    """(n,) bool: whether each finite symmetric (n, d, d) matrix is positive definite, by Cholesky (its lower
+    triangle): all at once, and one by one only when one of them fails."""
+    try:
+        np.linalg.cholesky(P)
+        return np.ones(len(P), bool)
+    except np.linalg.LinAlgError:
+        out = np.ones(len(P), bool)
+        for i, one in enumerate(P):
+            try:
+                np.linalg.cholesky(one)
+            except np.linalg.LinAlgError:
+                out[i] = False
+        return out
+
+
 def _members(track_group: np.ndarray, meas_group: np.ndarray):
     """(tracks, measurements) of each group numbered >= 0 in `track_group`, in increasing group order, both sorted;
     one sort instead of two scans per group."""
@@ -280,7 +317,12 @@ class LabelledMultiBernoulli(Tracker):
         weights = np.r_[w_det, t.w * miss] / np.maximum(r_new[track], EPS)
         means = np.r_[inn.corrected_means(t.m, z, c, j), t.m]
         covs = np.concatenate([inn.P[c], t.P])
-        keep = np.flatnonzero(r_new > p["prune"])
+        # Diverged components (see `diverged`) are dropped, and a track left without a component with them; a weight
+        # of 0 makes `replace` drop a component, and nothing else changes where none has diverged.
+        broken = diverged(means, covs, self.image_size)
+        weights = np.where(broken, 0.0, weights)
+        alive = np.bincount(track[weights > 0], minlength=n_tracks) > 0
+        keep = np.flatnonzero((r_new > p["prune"]) & alive)
         t.replace(r_new, track, weights, means, covs, keep, p["max_components"], p["prune"])
 
         associated = beta[:, :n_meas].sum(axis=0) if n_tracks else np.zeros(n_meas)
