@@ -92,6 +92,8 @@ def test_bad_inputs():
         association_probabilities(np.ones((1, 1)), 0.9, 0.0)
     with pytest.raises(ValueError, match="positive integer"):
         association_probabilities(np.ones((1, 1)), 0.9, 1.0, k=0)
+    with pytest.raises(ValueError, match="budget must be None"):
+        association_probabilities(np.ones((1, 1)), 0.9, 1.0, budget=0)
     with pytest.raises(ValueError, match="no joint event"):
         association_probabilities(np.zeros((1, 1)), 1.0, 1.0)
 
@@ -212,6 +214,7 @@ def test_two_targets_apart_sharing_one_measurement_are_not_merged():
 def test_jpda_exact_uses_every_joint_event():
     exact, approx = trackers.make("jpda_exact"), trackers.make("jpda")
     assert exact._k(3, 4) is None and approx._k(3, 4) == 7 and exact._k(9, 9) == 5000
+    assert exact._budget() == 5000 and approx._budget() is None  # the budget: jpda_exact's alone
 
 
 @pytest.mark.parametrize("name", ["jpda", "jpda_exact"])
@@ -277,3 +280,76 @@ def test_a_duplicate_sharing_one_blob_for_long_is_dropped():
     b = lambda k: (20 + 2 * k, 58) if k < 3 else None  # noqa: E731  (merged into a's blob from frame 3 on)
     t, out = run([a, b], 30, meas_sigma=6.0, merge_frames=10, **PAPER)
     assert out[5][1] == [OCCLUDED, OCCLUDED] and len(t.book) == 1 and out[-1][0] == [1]
+
+
+# ------------------------------------------------------------------ jpda_exact's budget (issue 37)
+
+# the tuning draw that ran over 30 minutes on one sequence: a 50 px meas_sigma, so every gate takes in every detection
+WIDE = {"meas_sigma": 49.77, "gate_probability": 0.9703, "accel_sigma": 1.34, "speed_sigma0": 10.9, "pd": 0.917,
+        "clutter_density": 4.1e-5, "min_hits": 2, "vanish_frames": 1}
+
+
+def counting_events(monkeypatch, stop_after):
+    """Count the joint events the enumeration lists; fail (rather than hang) once it lists more than `stop_after`."""
+    from mtt_sim.trackers import jpda
+    listed, original = [], jpda._joint_events
+
+    def counted(w, miss):
+        listed.append(0)
+        for event in original(w, miss):
+            listed[-1] += 1
+            assert listed[-1] <= stop_after, "the enumeration ran past the budget"
+            yield event
+
+    monkeypatch.setattr(jpda, "_joint_events", counted)
+    return listed
+
+
+def test_a_cluster_over_the_budget_lists_one_event_past_it_then_takes_murtys_best(monkeypatch):
+    """8 targets and 12 measurements, all in one gate: about 10^9 joint events. With a budget of 300 the listing stops
+    at the 301st and the cluster gets its 300 most probable events, exactly what k=300 (Murty) gives."""
+    g = np.random.default_rng(7).uniform(0.5, 2.0, (8, 12))
+    listed = counting_events(monkeypatch, 301)
+    beta = association_probabilities(g, 0.9, 1.0, budget=300)
+    assert listed == [301]
+    np.testing.assert_array_equal(beta, association_probabilities(g, 0.9, 1.0, k=300))
+    assert np.isfinite(beta).all() and np.allclose(beta.sum(axis=1), 1.0)
+    assert _all_events(*_factors(g, 0.9, 1.0), limit=300) is None
+
+
+@settings(max_examples=150, deadline=None)
+@given(problems())
+def test_below_the_budget_it_is_the_exact_enumeration_and_over_it_the_budgets_best(problem):
+    g, pd, lam = problem
+    n_events = len(_all_events(*_factors(g, pd, lam)))
+    exact = association_probabilities(g, pd, lam)
+    np.testing.assert_allclose(exact, brute_force(g, pd, lam), rtol=1e-9, atol=1e-12)
+    for budget in (n_events, n_events + 1, 10**6):   # at or below the budget: the same numbers, to the bit
+        np.testing.assert_array_equal(association_probabilities(g, pd, lam, budget=budget), exact)
+    if n_events > 1:
+        np.testing.assert_array_equal(association_probabilities(g, pd, lam, budget=n_events - 1),
+                                      association_probabilities(g, pd, lam, k=n_events - 1))
+
+
+def test_jpda_exact_with_wide_gates_stops_at_its_budget(monkeypatch):
+    """The tuning draw's wide gates on a crowd: 9 people 12 px apart, then 14 detections among them. Every cluster
+    of the second frame stops listing at max_events + 1 and is ranked by Murty instead."""
+    from mtt_sim.trackers import jpda
+    ranked = []
+    best_events = jpda._best_events
+    monkeypatch.setattr(jpda, "_best_events", lambda w, miss, k: ranked.append((w.shape, k)) or best_events(w, miss, k))
+    tracker = trackers.make("jpda_exact", **WIDE, max_exact_targets=9, max_events=200)
+    tracker.reset({})
+    rng = np.random.default_rng(3)
+
+    def obs(centres):
+        dets = np.zeros((16, 5), np.float32)
+        dets[: len(centres)] = [(x - 10, y - 20, 20, 40, 0.9) for x, y in centres]
+        return {"detections": dets, "num_detections": len(centres)}
+
+    tracker.update(obs([(100 + 12 * i, 100) for i in range(9)]))
+    listed = counting_events(monkeypatch, 201)
+    tracks = tracker.update(obs(np.c_[rng.uniform(90, 210, 14), rng.uniform(90, 110, 14)]))
+    assert listed and all(n == 201 for n in listed)              # each listing stopped one past the budget
+    assert ranked and all(k == 200 and shape == (9, 14) for shape, k in ranked)
+    assert np.isfinite(tracks.boxes).all()

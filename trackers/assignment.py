@@ -128,9 +128,11 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
             forced[i, :], forced[:, cols[i]] = np.inf, np.inf
             forced[i, cols[i]] = keep
         # Only k - len(out) more are popped, each no dearer than the cheapest that many now open (children never
-        # cost less than their parent): dearer subproblems can go, which bounds the memory to about k matrices.
+        # cost less than their parent): dearer subproblems can go, which bounds the memory to about 2k matrices.
+        # Pruning only once the heap holds twice that many keeps its cost (a selection over the heap) from growing
+        # as k^2; the pops, ordered by (cost, counter), are the same whenever it prunes.
         remaining = k - len(out)
-        if len(heap) > remaining > 0:
+        if len(heap) > 2 * remaining > 0:
             limit = heapq.nsmallest(remaining, heap)[-1][0]
             heap = [node for node in heap if node[0] <= limit]
             heapq.heapify(heap)

@@ -11,6 +11,8 @@ assignment problem whose cost is -log of those factors, with one dummy "missed" 
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -37,23 +39,30 @@ def _factors(g, pd, clutter_density) -> tuple[np.ndarray, np.ndarray]:
     return pd[:, None] * g / clutter_density, 1.0 - pd
 
 
-def _all_events(w: np.ndarray, miss: np.ndarray) -> list[tuple[list[int], float]]:
-    """Every joint event with a nonzero weight: (measurement of each target or -1, weight)."""
-    n, m = w.shape
-    events = []
+def _joint_events(w: np.ndarray, miss: np.ndarray):
+    """Every joint event with a nonzero weight, one at a time (depth first, target 0's choice varying slowest, a miss
+    before the measurements): (measurement of each target or -1, weight)."""
+    n = w.shape[0]
+    options = [np.flatnonzero(row).tolist() for row in w]
 
     def extend(t: int, chosen: list[int], used: set[int], weight: float):
         if t == n:
-            events.append((list(chosen), weight))
+            yield list(chosen), weight
             return
         if miss[t] > 0:
-            extend(t + 1, chosen + [-1], used, weight * miss[t])
-        for j in np.flatnonzero(w[t]).tolist():
+            yield from extend(t + 1, chosen + [-1], used, weight * miss[t])
+        for j in options[t]:
             if j not in used:
-                extend(t + 1, chosen + [j], used | {j}, weight * w[t, j])
+                yield from extend(t + 1, chosen + [j], used | {j}, weight * w[t, j])
 
-    extend(0, [], set(), 1.0)
-    return events
+    return extend(0, [], set(), 1.0)
+
+
+def _all_events(w: np.ndarray, miss: np.ndarray, limit: int | None = None) -> list[tuple[list[int], float]] | None:
+    """Every joint event with a nonzero weight: (measurement of each target or -1, weight); None if there are more
+    than `limit` (the listing stops at the first one past it, so a cluster of millions costs `limit` steps)."""
+    events = list(itertools.islice(_joint_events(w, miss), None if limit is None else limit + 1))
+    return None if limit is not None and len(events) > limit else events
 
 
 def _best_events(w: np.ndarray, miss: np.ndarray, k: int) -> list[tuple[list[int], float]]:
@@ -70,23 +79,28 @@ def _best_events(w: np.ndarray, miss: np.ndarray, k: int) -> list[tuple[list[int
     return [(np.where(cols < m, cols, -1).tolist(), float(np.exp(low - total))) for cols, total in best]
 
 
-def association_probabilities(g, pd, clutter_density: float, k: int | None = None) -> np.ndarray:
+def association_probabilities(g, pd, clutter_density: float, k: int | None = None,
+                             budget: int | None = None) -> np.ndarray:
     """beta (n_targets, m + 1): beta[t, 0] the probability that no measurement is target t's, beta[t, j + 1] that
     measurement j is. g (n, m) Gaussian likelihoods, 0 where gated out; pd scalar or per target; k=None enumerates
-    every joint event, an int uses the k best from Murty (renormalised)."""
+    every joint event, an int uses the k best from Murty (renormalised). budget (with k=None): the most joint events
+    enumerated; a cluster with more takes its `budget` most probable instead (Murty: the paper's K-best
+    approximation with K = budget), so its cost is bounded however wide the gates."""
     w, miss = _factors(g, pd, clutter_density)
     n, m = w.shape
     if k is not None and (not isinstance(k, (int, np.integer)) or k < 1):
         raise ValueError(f"k must be None (exact) or a positive integer, got {k!r}")
+    if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
+        raise ValueError(f"budget must be None (no limit) or a positive integer, got {budget!r}")
     # Few joint events (bounded by the product of each target's options): enumerating them all and keeping the k
     # heaviest gives the same k best events as Murty, far cheaper than its subproblems. Otherwise Murty.
     few = np.prod(1.0 + (w > 0).sum(axis=1)) <= ENUMERATE_UP_TO
     if k is None:
-        events = _all_events(w, miss)
-    elif few:
-        events = sorted(_all_events(w, miss), key=lambda e: -e[1])[: int(k)]
-    else:
-        events = _best_events(w, miss, int(k))
+        events = _all_events(w, miss, budget)
+        if events is None:  # more joint events than the budget: the budget's best
+            k = budget
+    if k is not None:
+        events = sorted(_all_events(w, miss), key=lambda e: -e[1])[: int(k)] if few else _best_events(w, miss, int(k))
     total = sum(weight for _, weight in events)
     if not total > 0:
         raise ValueError("no joint event has a nonzero probability (pd = 1 and a target without a gated measurement?)")
@@ -300,7 +314,8 @@ class Jpda(Tracker):
         beta[alone, 0], beta[alone, 1:] = (1 - p["pd"]) / total[:, 0], w / total
         for c in np.unique(t_label[has & ~alone]):
             ti, zj = np.flatnonzero(t_label == c), np.flatnonzero(z_label == c)
-            b = association_probabilities(g[np.ix_(ti, zj)], p["pd"], p["clutter_density"], self._k(len(ti), len(zj)))
+            b = association_probabilities(g[np.ix_(ti, zj)], p["pd"], p["clutter_density"], self._k(len(ti), len(zj)),
+                                          self._budget())
             beta[ti, 0] = b[:, 0]
             beta[np.ix_(ti, zj + 1)] = b[:, 1:]
         return beta, gated, g
@@ -335,6 +350,10 @@ class Jpda(Tracker):
     def _k(self, n_targets: int, n_measurements: int) -> int | None:
         """How many joint events a cluster uses: the paper's K = targets + measurements unless set."""
         return self.params["k"] or n_targets + n_measurements
+
+    def _budget(self) -> int | None:
+        """The most joint events a cluster enumerated in full may have (with k None); None: no limit."""
+        return None
 
     def _jpda_update(self, beta: np.ndarray, z: np.ndarray) -> None:
         """Eq. 10-12 for every target at once: the beta-weighted innovation, and the covariance with its spread."""
@@ -421,15 +440,25 @@ class Jpda(Tracker):
 @register
 class JpdaExact(Jpda):
     """Traditional JPDA, as the paper's baseline: the same filter, but every joint event of a cluster is enumerated
-    (exponential in the cluster size). Clusters of more than max_exact_targets targets fall back to the
-    max_events most probable events (Murty), so a crowd cannot stall it; that is the cap."""
+    (exponential in the cluster size), within a budget: a cluster of more than max_events joint events (counted as
+    they are listed, so the listing stops there) or of more than max_exact_targets targets takes its max_events most
+    probable joint events instead, found by Murty's algorithm: the paper's own K-best approximation, with K = the
+    budget. So wide gates or a crowd cannot stall it (max_events=5000: a cluster costs at most 5000 events, listed
+    or ranked); below the budget it is exact."""
 
     name = "jpda_exact"
-    description = "Traditional JPDA: every joint event enumerated (clusters capped at max_exact_targets targets)"
+    description = "Traditional JPDA: every joint event enumerated, up to max_events a cluster (then Murty's best)"
     parameters = {
         **Jpda.parameters,
         "max_exact_targets": Param(8, "[0, 20]", "largest cluster (targets) whose joint events are all enumerated"),
-        "max_events": Param(5000, "[1, inf)", "joint events (Murty's best) for a larger cluster")}
+        "max_events": Param(5000, "[1, inf)", "the budget: most joint events a cluster enumerates; a cluster with "
+                                              "more (or over max_exact_targets targets) takes this many of its most "
+                                              "probable (Murty)")}
 
     def _k(self, n_targets: int, n_measurements: int) -> int | None:
         return None if n_targets <= self.params["max_exact_targets"] else self.params["max_events"]
+
+    def _budget(self) -> int | None:
+        # The budget (issue 37): a 50 px meas_sigma's gates took in every detection, and listing a cluster's joint
+        # events ran over 30 minutes on one sequence; past max_events the cluster gets Murty's max_events best.
+        return self.params["max_events"]
