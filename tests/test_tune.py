@@ -1,7 +1,8 @@
 """`mtt-sim tune`: the metric goals, the spec a study writes, one seed one study (whatever the workers), a tuned spec
 that beats its defaults where they are known to be poor, failed trials, resumed studies, the command line; a study's
 definition (its default name, another one refused), interrupted trials (marked, not counted, rerun first, the
-resumed study as an uninterrupted one), Ctrl-C on the command (the best so far, --out, status 130)."""
+resumed study as an uninterrupted one), Ctrl-C on the command (the best so far, --out, status 130), a study in which
+every trial failed (why, in one line, and status 1)."""
 
 import json
 import os
@@ -317,3 +318,19 @@ def test_ctrl_c_on_the_command_reports_the_best_so_far_writes_out_and_exits_130(
     assert err.splitlines()[-1].startswith("mtt-sim tune: error: study 's' was made for another tuning (metric: was "
                                            "'maximize HOTA', now 'maximize MOTA') and its trials would mix")
 
+
+def test_a_study_in_which_every_trial_failed_says_why_in_one_line_and_exits_1(monkeypatch, capsys):
+    def failing(tasks, *args, **kwargs):
+        return [{"scenario": t[0], "error": "RuntimeError: the scene fell over\n  at frame 3", "metrics": None}
+                for t in tasks]
+
+    monkeypatch.setattr(tune, "run_tasks", failing)
+    with pytest.raises(tune.NoTrialFinished, match=r"^no trial finished: RuntimeError: the scene fell over$"):
+        tune.tune("sort", ["mot17_like"], trials=2, config=TINY)
+    assert cli.main(["tune", "sort", "--on", "mot17_like", "--trials", "2", "--config", "env.max_steps=5",
+                     "--json"]) == 1
+    printed, err = capsys.readouterr()
+    assert printed == "" and "Traceback" not in err
+    assert err.splitlines()[-3:] == ["trial 0 failed: RuntimeError: the scene fell over",
+                                     "trial 1 failed: RuntimeError: the scene fell over",
+                                     "mtt-sim tune: error: no trial finished: RuntimeError: the scene fell over"]

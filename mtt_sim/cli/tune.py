@@ -85,6 +85,9 @@ def run(args) -> int:
                   file=sys.stderr)
             return INTERRUPTED
         result, study = stop.result, stop.study
+    except tune.NoTrialFinished as err:  # every trial failed (or was pruned): why, in one line, and no result
+        print(f"mtt-sim tune: error: {err}", file=sys.stderr)
+        return 1
     if out:
         out.write_text(result.toml())
     if plot:

@@ -71,6 +71,11 @@ class Result:
         return to_toml({**head, **scores, "params": self.params})
 
 
+class NoTrialFinished(RuntimeError):
+    """A study in which no trial completed: each failed by its own error, was pruned or interrupted. The message, one
+    line, names why: the trials' distinct errors (each's first line), or their states."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C during a study: the trial in flight marked interrupted, `result` the best so far (None if no trial had
     finished) and `study` the Optuna study. A KeyboardInterrupt, so a caller that does not look stops as before."""
@@ -171,7 +176,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
         if interrupted:
             try:
                 result = _result(study, name, fixed, wanted)
-            except RuntimeError:  # no trial has finished yet
+            except NoTrialFinished:  # no trial has finished yet
                 result = None
             else:
                 result.interrupted = True
@@ -260,8 +265,8 @@ def _result(study, name: str, fixed: Mapping, wanted: list[Goal]) -> Result:
 
     done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
     if not done:
-        raise RuntimeError("no trial finished: " + "; ".join(sorted({t.user_attrs.get("error") or state(t)
-                                                                     for t in study.trials})))
+        why = sorted({(t.user_attrs.get("error") or "").partition("\n")[0] or state(t) for t in study.trials})
+        raise NoTrialFinished("no trial finished: " + "; ".join(why))
     counts = {}
     for t in study.trials:
         counts[state(t)] = counts.get(state(t), 0) + 1
