@@ -108,6 +108,7 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
     if first is None:
         return []
     heap = [(first[1], 0, first[0], cost)]
+    earlier = np.tri(n, k=-1, dtype=bool)  # [i, j]: row j comes before row i
     out, counter = [], 1
     while heap and len(out) < k:
         total, _, cols, node = heapq.heappop(heap)
@@ -115,7 +116,7 @@ def murty(cost: np.ndarray, k: int) -> list[tuple[np.ndarray, float]]:
         forced = node.copy()
         # row i's open columns once rows 0..i-1 are forced: its own, less those that rows 0..i-1 took
         finite = np.isfinite(node)
-        alternatives = (finite.sum(axis=1) - np.tril(finite[:, cols], -1).sum(axis=1)).tolist()
+        alternatives = (finite.sum(axis=1) - (finite[:, cols] & earlier).sum(axis=1)).tolist()
         for i in range(n):
             if alternatives[i] > 1:  # a row with one open column (forced, or left so) has no alternative
                 child = forced.copy()

@@ -104,10 +104,11 @@ def association_probabilities(g, pd, clutter_density: float, k: int | None = Non
     total = sum(weight for _, weight in events)
     if not total > 0:
         raise ValueError("no joint event has a nonzero probability (pd = 1 and a target without a gated measurement?)")
-    beta = np.zeros((n, m + 1))
-    rows = np.arange(n)
-    for chosen, weight in events:
-        beta[rows, np.asarray(chosen, int) + 1] += weight
+    # each event adds its weight to its n (target, choice) cells, event after event (as a loop would, to the bit)
+    chosen = np.array([c for c, _ in events], np.intp).reshape(len(events), n)
+    cells = (np.arange(n) * (m + 1) + chosen + 1).ravel()
+    weights = np.repeat(np.array([weight for _, weight in events], float), n)
+    beta = np.bincount(cells, weights=weights, minlength=n * (m + 1)).reshape(n, m + 1)
     return beta / total
 
 
