@@ -79,11 +79,11 @@ def diverged(m: np.ndarray, P: np.ndarray, image_size: tuple[float, float]) -> n
     that is not positive definite, a box with a non-positive width or height or one over two images wide or high, or
     a corner more than one image beyond the border (the env's action space, which trackers may not import).
 
-    Why it is needed: the noise scales with the box, so at the ends of the search ranges (process noise 0.1, a 0.9999
-    gate, survival 0.999, extract 0.2) a component that took a far detection learns a velocity or a growth rate its
-    wider gate then feeds, and a coasting track can run an image beyond the border or grow to thousands of pixels.
-    The filter's state space is boxes in view (the paper's detection probability is of targets in the image), so such
-    a component is a numerical runaway, not a hypothesis; with ordinary parameters none is ever flagged."""
+    Why: at the ends of the search ranges (process noise 0.1, a 0.9999 gate, survival 0.999, extract 0.2) a component
+    that took a far detection learns a large velocity or growth rate (its noise, and so its gate, grows with its box)
+    and runs off while its track coasts: an image beyond the border, or thousands of pixels tall, on MOT15. The
+    filter's state space is boxes the camera sees (the paper's targets are those in the image), so such a component is
+    a numerical runaway, not a hypothesis; with ordinary parameters none is ever flagged (outputs unchanged to the bit)."""
     w, h = image_size
     box = m[:, :4]
     finite = np.isfinite(m).all(axis=1) & np.isfinite(P).all(axis=(1, 2))
@@ -170,7 +170,8 @@ class LabelledMultiBernoulli(Tracker):
     detections stay in the filter. birth=fixed instead places `fixed_births` newborn components along the image
     borders every frame (the traditional model). Tracks with r > `extract` are reported (coast=false: only those
     that took a measurement this frame, an ablation of coasting), tracks under `prune` are dropped, and each keeps
-    at most `max_components` components. use_low_confidence=false first drops detections under `low_confidence`
+    at most `max_components` components; a component that diverged (`diverged`: not finite, not positive definite, a box
+    beyond the action space) is dropped. use_low_confidence=false first drops detections under `low_confidence`
     (the paper's Ours_2). Clutter is uniform over the image for x, y and over
     [0, W/4] x [0, H/2] for w, h, at `clutter_rate` per frame.
     Re-identification (sec. 3, 4.4; reid=false turns it off): every `pool_every` frames a reported track whose
