@@ -63,7 +63,9 @@ class TrackingEnv(gym.Env):
     **Info** at reset: ``init_ids`` and ``init_boxes`` of the targets visible in the first frame, for
     trackers initialised by hand, ``image_size`` (width, height), ``frame_rate`` and ``length`` (frames;
     None for a scenario, which ends when its world does). Every step: ``info["frame"]``, the frame's counts (tp, fp, fn, idsw,
-    num_gt, similarity_sum); on the last step ``info["metrics"]``, the episode's MOTA, IDF1, HOTA, GOSPA
+    num_gt, similarity_sum); a scenario's ``info["camera_warp"]`` (at reset too), the 2x3 float warp that took the
+    previous frame's pixel coordinates onto this frame's (BoT-SORT's GMC convention; the identity at reset); on the
+    last step ``info["metrics"]``, the episode's MOTA, IDF1, HOTA, GOSPA
     and the rest (see ``mtt_sim.metrics``). ``env.unwrapped.truth`` is the current ground truth.
     """
 
@@ -160,6 +162,8 @@ class TrackingEnv(gym.Env):
         init_ids, init_boxes = self.source.first_targets()
         info = {"frame_index": 0, "init_ids": init_ids, "init_boxes": init_boxes, "image_size": self.source.image_size,
                 "frame_rate": self.source.frame_rate, "length": self.source.length}
+        if hasattr(self.source, "camera_warp"):
+            info["camera_warp"] = self.source.camera_warp
         if self._viewer:
             self.render()
         return obs, info
@@ -188,6 +192,8 @@ class TrackingEnv(gym.Env):
         truncated = bool(self.steps >= self.config.env.max_steps and not terminated)
         self._done = terminated or truncated
         info = {"frame_index": self.steps, "frame": dict(vars(stats))}
+        if hasattr(self.source, "camera_warp"):
+            info["camera_warp"] = self.source.camera_warp
         if self._done and self.scored:
             info["metrics"] = self.metrics.summary()
         if self._viewer:

@@ -1,5 +1,6 @@
 """Export: an episode written as a MOTChallenge sequence folder (frames, ground truth, detections, seqinfo.ini), in
-the layout `mtt_sim.real.motchallenge` describes, for tools that read the benchmark's files."""
+the layout `mtt_sim.real.motchallenge` describes, for tools that read the benchmark's files; a simulated scene's
+camera motion beside it as gmc.txt, in BoT-SORT's GMC format, so that camera-motion compensation can be checked."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from pathlib import Path
 from typing import Mapping
 
 import cv2
+import numpy as np
 from tqdm import tqdm
 
 from mtt_sim.env import TrackingEnv
@@ -34,7 +36,7 @@ def export_episode(scenario: str, out: str | Path, seed: int = 0, steps: int | N
     if "frame" in episode.obs:
         (out / "img1").mkdir(exist_ok=True)
     sc = env.config
-    gt_rows, det_rows = [], []
+    gt_rows, det_rows, warps = [], [], []
     with tqdm(total=episode.limit, unit="frame", desc=f"exporting {out}", disable=not progress) as bar:
         for now in episode:
             frame = now.steps + 1  # numbered from 1; after the loop, the number of frames
@@ -47,6 +49,8 @@ def export_episode(scenario: str, out: str | Path, seed: int = 0, steps: int | N
                         for i, b, c, v in zip(t.ids, t.boxes.tolist(), considered, t.visibility)]
             dets = now.obs["detections"][: int(now.obs["num_detections"])]
             det_rows += [(frame, -1, *d[:4], d[4], -1, -1, -1) for d in dets.tolist()]
+            if hasattr(env.source, "camera_warp"):
+                warps.append(env.source.camera_warp)
             bar.update()
     if recorded and env.scored:  # the recording's own ground truth, its lines as written, cut to the frames
         gt = env.source.folder / "gt" / "gt.txt"
@@ -57,6 +61,11 @@ def export_episode(scenario: str, out: str | Path, seed: int = 0, steps: int | N
     else:
         write_rows(out / "gt" / "gt.txt", gt_rows)
     write_rows(out / "det" / "det.txt", det_rows)
+    gmc = out / "gmc.txt"
+    if warps:
+        gmc.write_text(gmc_text(warps))
+    elif gmc.exists():  # an earlier export's, of another source
+        gmc.unlink()
     info = configparser.ConfigParser()
     info.optionxform = str
     name = f"{env.source.info.name}-twin" if recorded else sc.name
@@ -67,3 +76,9 @@ def export_episode(scenario: str, out: str | Path, seed: int = 0, steps: int | N
     with (out / "seqinfo.ini").open("w") as f:
         info.write(f, space_around_delimiters=False)
     return {"frames": frame, "gt_rows": len(gt_rows), "det_rows": len(det_rows), "folder": str(out)}
+
+
+def gmc_text(warps) -> str:
+    """Per-frame 2x3 warps as BoT-SORT writes its GMC files: a line a frame, its 0-based index, then a00 a01 a02 a10
+    a11 a12 with 6 decimals, each followed by a tab."""
+    return "".join(f"{k}\t" + "".join(f"{v:.6f}\t" for v in np.ravel(w)) + "\n" for k, w in enumerate(warps))

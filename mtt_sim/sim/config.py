@@ -123,10 +123,38 @@ class RenderConfig:
     noise: float = setting(0.0, "Gaussian pixel noise standard deviation", "grey levels", 0.0, 100.0)
     blur: float = setting(0.0, "Gaussian blur sigma (0 = none)", "px", 0.0, 20.0)
     camera: str = setting("static", "static; pan: sweeps across a larger world; follow: keeps the targets' mean centred; "
-                       "shake: handheld jitter", choices=("static", "pan", "follow", "shake"))
+                       "shake: handheld jitter; trace: replays the camera-motion file `trace`; walking: a camera "
+                       "carried along, its motion drawn from a model fitted to real walking and driving cameras; "
+                       "still: a camera on a tripod, its jitter fitted to real ones (docs/camera_motion.md)",
+                       choices=("static", "pan", "follow", "shake", "trace", "walking", "still"))
     pan_speed: tuple[float, float] = setting((2.0, 0.0), "pan: camera velocity, reversing at the world's edges; follow: its "
                                           "largest speed", "px/frame", -100.0, 100.0)
     shake: float = setting(3.0, "shake: standard deviation of the camera offset", "px", 0.0, 100.0)
+    trace: str = setting("", "trace: a camera-motion file in BoT-SORT's GMC format (a line a frame: its 0-based index, "
+                         "then the 2x3 warp a00 a01 a02 a10 a11 a12 from the previous frame's pixels onto this one's), "
+                         "replayed from the middle of the world, frame k with line k; past its last line the camera "
+                         "holds its last pose. A relative path is the scenario file's folder's, else the working "
+                         "directory's")
+    camera_step: tuple[float, float] = setting((0.00067, 0.00061), "walking: spread of the camera's shift a frame, "
+                                               "across and down (a Student-t scale; see camera_tail)", "width/frame",
+                                               0.0, 0.2)
+    camera_step_corr: tuple[float, float] = setting((0.862, 0.087), "walking: frame-to-frame correlation of that shift, "
+                                                    "across and down (AR(1))", "", 0.0, 0.999)
+    camera_turn: float = setting(0.0609, "walking: spread of the camera's roll a frame", "deg/frame", 0.0, 10.0)
+    camera_turn_corr: float = setting(0.02, "walking: frame-to-frame correlation of the roll", "", 0.0, 0.999)
+    camera_zoom: float = setting(0.098, "walking: spread of the camera's scale change a frame (walking forward and "
+                                 "back)", "%/frame", 0.0, 10.0)
+    camera_zoom_corr: float = setting(0.747, "walking: frame-to-frame correlation of the scale change", "", 0.0, 0.999)
+    camera_tail: float = setting(1.1, "walking: Student-t degrees of freedom of the motion's innovations (small: heavy "
+                                 "tails, a camera mostly slow and at times fast; 1000: Gaussian; a draw is capped at "
+                                 "50 scales)", "", 1.0, 1000.0)
+    camera_return: float = setting(40.0, "walking and still: a spring pulls the camera back toward its rest pose, "
+                                   "with a period of about 2 pi times this, so that it stays over the world",
+                                   "frames", 1.0, 1e6)
+    still_jitter: float = setting(2.74e-05, "still: spread of the camera's shift a frame, either way (a Student-t scale)",
+                                  "width/frame", 0.0, 0.01)
+    still_jitter_corr: float = setting(0.258, "still: frame-to-frame correlation of that shift", "", 0.0, 0.999)
+    still_tail: float = setting(1.8, "still: Student-t degrees of freedom of the jitter's innovations", "", 1.0, 1000.0)
 
 
 def _fitted_detectors() -> dict[str, dict[str, Any]]:

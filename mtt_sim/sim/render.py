@@ -14,6 +14,7 @@ from functools import cached_property
 import cv2
 import numpy as np
 
+from mtt_sim.sim.camera import Camera, WarpCamera, compose, invert, make_camera, shift, warp_boxes  # noqa: F401
 from mtt_sim.sim.config import TEXTURES, Scenario
 from mtt_sim.sim.world import World
 
@@ -49,55 +50,17 @@ def draw_blob(img: np.ndarray, box, is_rect: bool, value) -> None:
     draw_fixed(img, geometry, 0, is_rect, value)
 
 
-class Camera:
-    """Where the image window sits in the world: static, panning back and forth, following the targets, or shaking
-    by hand."""
-
-    def __init__(self, sc: Scenario, rng: np.random.Generator):
-        r = sc.render
-        self.mode, self.rng = r.camera, rng
-        self.image_size = np.array([r.width, r.height], float)
-        self.span = np.array(sc.world_size) - self.image_size
-        self.velocity = np.array(r.pan_speed, float)
-        self.sigma = r.shake
-        self.base = self.span / 2 if self.mode not in ("pan", "follow") else np.zeros(2)
-        self.jitter = np.zeros(2)
-        self.margin = int(math.ceil(4 * self.sigma)) if self.mode == "shake" else 0
-
-    @property
-    def offset(self) -> np.ndarray:
-        """World coordinates of the image's top-left pixel (integer: the background is cropped, not resampled)."""
-        return np.round(self.base + self.jitter)
-
-    def follow(self, world: World, max_step: np.ndarray | float = np.inf):
-        """Move toward centring the targets' mean in the image, at most `max_step` per axis (a following camera
-        jumps there at reset)."""
-        if len(world.ids):
-            boxes = world.boxes()
-            wanted = (boxes[:, :2] + boxes[:, 2:] / 2).mean(axis=0) - self.image_size / 2
-            self.base = np.clip(self.base + np.clip(wanted - self.base, -max_step, max_step), 0, self.span)
-
-    def advance(self, world: World):
-        if self.mode == "follow":
-            self.follow(world, np.abs(self.velocity))
-        elif self.mode == "pan":
-            nxt = self.base + self.velocity
-            bounce = (nxt < 0) | (nxt > self.span)
-            self.velocity = np.where(bounce, -self.velocity, self.velocity)
-            self.base = np.clip(nxt, 0, self.span)
-        elif self.mode == "shake":  # AR(1): a handheld camera drifts around its rest position
-            self.jitter = 0.7 * self.jitter + self.rng.normal(0, self.sigma * math.sqrt(1 - 0.49), 2)
-            self.jitter = np.clip(self.jitter, -self.margin, self.margin)
-
-
 class Renderer:
-    """Draws frames and label maps of a World seen through a Camera."""
+    """Draws frames and label maps of a World seen through a Camera (or a WarpCamera: `trace` holds the warps a
+    trace camera replays)."""
 
-    def __init__(self, sc: Scenario, rng: np.random.Generator):
+    def __init__(self, sc: Scenario, rng: np.random.Generator, trace: np.ndarray | None = None):
         self.sc, self.rng = sc, rng
         r = sc.render
         self.shape = (r.height, r.width)
-        self.camera = Camera(sc, np.random.default_rng(rng.integers(2**63)))
+        self.camera = make_camera(sc, np.random.default_rng(rng.integers(2**63)), trace)
+        self.warped = isinstance(self.camera, WarpCamera)
+        self.reference: tuple[np.ndarray, np.ndarray] | None = None  # a warped frame's boxes before the warp, and it
         self.photometric_seed = int(rng.integers(2**63))
         occ = sc.occluders
         self.occluder_boxes = np.array([o.rect for o in occ], float).reshape(-1, 4)
@@ -122,7 +85,7 @@ class Renderer:
         return self._looks[0]
 
     def _background(self) -> np.ndarray:
-        """The static world backdrop, with a margin for a shaking camera."""
+        """The static world backdrop, with a margin for a shaking or warping camera."""
         r = self.sc.render
         m = self.camera.margin
         w, h = (int(math.ceil(v)) + 2 * m for v in self.sc.world_size)
@@ -144,17 +107,23 @@ class Renderer:
         return img
 
     def image_boxes(self, world: World) -> np.ndarray:
-        """Every target's drawn box in image pixels."""
+        """Every target's drawn box in image pixels (a warping camera's: the bounding box of its warped corners)."""
         boxes = world.boxes()
+        if self.warped:
+            return warp_boxes(boxes, self.camera.pose)
         boxes[:, :2] -= self.camera.offset
         return boxes
 
     def occluder_image_boxes(self) -> np.ndarray:
         """Every occluder's box in image pixels."""
+        if self.warped:
+            return warp_boxes(self.occluder_boxes, self.camera.pose)
         return self.occluder_boxes - np.append(self.camera.offset, (0, 0))
 
     def render(self, world: World, draw_frame: bool = True, show_targets: bool = True):
         """(frame or None, labels, image boxes) for the world's current state."""
+        if self.warped:
+            return self._render_warped(world, draw_frame, show_targets)
         h, w = self.shape
         off = self.camera.offset.astype(int)
         m = self.camera.margin
@@ -162,7 +131,51 @@ class Renderer:
         frame = self.canvas[off[1] + m: off[1] + m + h, off[0] + m: off[0] + m + w].copy() if draw_frame else None
         boxes = self.image_boxes(world)
         n = len(boxes) if show_targets else 0
-        all_boxes = np.concatenate([boxes[:n], self.occluder_image_boxes()])
+        self._draw(world, frame, labels, boxes[:n], self.occluder_image_boxes())
+        if frame is not None:
+            frame = self._photometric(frame, world.t)
+        return frame, labels, boxes
+
+    def _render_warped(self, world: World, draw_frame: bool, show_targets: bool):
+        """Draw the part of the world the image sees, as the static path does (a crop of the backdrop, the targets and
+        occluders on it), then warp it into the image by the camera's pose: the frame bilinearly, the label map by
+        nearest neighbour; what lies past the backdrop is the background colour."""
+        h, w = self.shape
+        pose = self.camera.pose
+        m = self.camera.margin
+        ww, wh = (int(math.ceil(v)) for v in self.sc.world_size)
+        corners = np.array([[0, 0], [w, 0], [0, h], [w, h]], float)
+        seen = corners @ invert(pose)[:, :2].T + invert(pose)[:, 2]
+        x0, y0 = np.clip(np.floor(seen.min(axis=0)).astype(int) - 1, -m, (ww + m, wh + m))
+        x1, y1 = np.clip(np.ceil(seen.max(axis=0)).astype(int) + 2, -m, (ww + m, wh + m))
+        world_boxes = world.boxes()
+        if x1 <= x0 or y1 <= y0:  # the image sees nothing of the world
+            x0, y0, x1, y1 = -m, -m, 1 - m, 1 - m  # a pixel of it, warped out of sight
+        labels = np.zeros((y1 - y0, x1 - x0), np.uint16)
+        frame = self.canvas[y0 + m: y1 + m, x0 + m: x1 + m].copy() if draw_frame else None
+        n = len(world_boxes) if show_targets else 0
+        local = world_boxes - (x0, y0, 0, 0)
+        self._draw(world, frame, labels, local[:n], self.occluder_boxes - (x0, y0, 0, 0))
+        crop_to_image = compose(pose, shift(x0, y0))  # in box coordinates; in pixel indices a centre is at +0.5:
+        lin = crop_to_image[:, :2]
+        to_image = np.c_[lin, crop_to_image[:, 2] + (lin - np.eye(2)) @ (0.5, 0.5)]
+        self.reference = (local, to_image)
+        labels = cv2.warpAffine(labels, to_image, (w, h), flags=cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT,
+                                borderValue=0)
+        if frame is not None:  # through four channels: the same pixels, in half the time of three
+            frame = cv2.warpAffine(cv2.cvtColor(frame, cv2.COLOR_RGB2RGBA), to_image, (w, h), flags=cv2.INTER_LINEAR,
+                                   borderMode=cv2.BORDER_CONSTANT,
+                                   borderValue=(*(int(c) for c in self.sc.render.background_color), 0))
+            frame = self._photometric(cv2.cvtColor(frame, cv2.COLOR_RGBA2RGB), world.t)
+        return frame, labels, warp_boxes(world_boxes, pose)
+
+    def _draw(self, world: World, frame: np.ndarray | None, labels: np.ndarray, boxes: np.ndarray,
+              occluder_boxes: np.ndarray) -> None:
+        """Draw the targets' `boxes` (the first len(boxes) slots) and the occluders in depth order into the label map
+        and the frame, both in the same pixel coordinates."""
+        h, w = labels.shape
+        n = len(boxes)
+        all_boxes = np.concatenate([boxes, occluder_boxes])
         onscreen = (all_boxes[:, 0] < w) & (all_boxes[:, 1] < h) & (all_boxes[:, 0] + all_boxes[:, 2] > 0) & \
                    (all_boxes[:, 1] + all_boxes[:, 3] > 0)
         order = np.argsort(np.concatenate([world.depth()[:n], self.occluder_depth]), kind="stable")
@@ -182,13 +195,10 @@ class Renderer:
                 draw_fixed(labels, geometry, i, rect[i], 0)
                 if frame is not None:
                     draw_fixed(frame, geometry, i, rect[i], self.sc.occluders[i - n].color)
-        if frame is not None:
-            frame = self._photometric(frame, world.t)
-        return frame, labels, boxes
 
     def _texture(self, frame, labels, i, box, kind, color):
         """Paint stripes, checks or noise on target i's visible pixels, fixed to the target so it moves with it."""
-        h, w = self.shape
+        h, w = labels.shape
         x0, y0 = max(int(box[0]), 0), max(int(box[1]), 0)
         x1, y1 = min(int(box[0] + box[2]) + 1, w), min(int(box[1] + box[3]) + 1, h)
         if x1 <= x0 or y1 <= y0:

@@ -283,6 +283,8 @@ def load_raw(key_or_path: str | Path, seen: tuple[str, ...] = ()) -> tuple[dict,
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"{where}: invalid TOML: {err}") from None
+    if isinstance(found, Path):
+        _anchor_trace(raw, found.parent)
     if "base" not in raw:
         return raw, where
     base = raw.pop("base")
@@ -292,6 +294,14 @@ def load_raw(key_or_path: str | Path, seen: tuple[str, ...] = ()) -> tuple[dict,
         return merge(load_raw(base, (*seen, str(found)))[0], raw), where
     except ConfigError as err:
         raise ConfigError(f"{where}: base = {base!r}: {err}") from None
+
+
+def _anchor_trace(raw: dict, folder: Path) -> None:
+    """A scenario file's relative render.trace (a camera-motion file) is relative to the file's folder."""
+    render = raw.get("render")
+    trace = render.get("trace") if isinstance(render, dict) else None
+    if isinstance(trace, str) and trace and not Path(trace).is_absolute():
+        render["trace"] = str(folder / trace)
 
 
 def expand_dotted(overrides: Mapping, prefix: str = "") -> dict:

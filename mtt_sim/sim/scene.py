@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtt_sim.sim.config import Scenario
+from mtt_sim.sim.config import ConfigError, Scenario
 from mtt_sim.sim.render import Renderer
 from mtt_sim.sim.sensor import Detections, Sensor, make_sensor
 from mtt_sim.sim.truth import Truth, measure
@@ -32,6 +32,7 @@ class Scene:
         self.sensor: Sensor | None = None
         self.truth: Truth | None = None
         self.labels: np.ndarray | None = None
+        self.trace = _trace(scenario)
 
     def detection_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Boxes lie in the image; confidences in conf_offset + [0, conf_scale] (and zero for padding rows)."""
@@ -43,7 +44,7 @@ class Scene:
               sensor_rng: np.random.Generator) -> None:
         sc = self.config
         self.world = World(sc, world_rng)
-        self.renderer = Renderer(sc, render_rng)
+        self.renderer = Renderer(sc, render_rng, self.trace)
         if sc.render.camera == "follow":
             self.renderer.camera.follow(self.world)
         empty = self.renderer.render(self.world, show_targets=False)[0] if sc.sensor.model == "foreground" else None
@@ -59,8 +60,15 @@ class Scene:
         """The truth of the frame just rendered: the targets' image boxes, what of them the label map shows, and who
         covers whom."""
         w = self.world
-        return measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group], self.renderer.occluder_image_boxes(),
-                       self.renderer.occluder_depth)
+        r = self.renderer
+        return measure(labels, w.ids, boxes, w.depth(), w.shape_is_rect[w.group], r.occluder_image_boxes(),
+                       r.occluder_depth, r.reference if r.warped else None)
+
+    @property
+    def camera_warp(self) -> np.ndarray:
+        """The 2x3 warp that took the previous frame's pixel coordinates onto this frame's (BoT-SORT's GMC
+        convention; the identity at the first frame and for a static camera)."""
+        return np.array(self.renderer.camera.warp, float)
 
     def first_targets(self) -> tuple[np.ndarray, np.ndarray]:
         """Ids and boxes of the targets visible in the first frame (for trackers initialised by hand)."""
@@ -82,3 +90,29 @@ class Scene:
     def finished(self) -> bool:
         """No target is alive and none can be born any more."""
         return bool(self.world.finished)
+
+
+def _trace(sc: Scenario) -> np.ndarray | None:
+    """The warps a `trace` camera replays, read and checked once; None for other cameras. The camera's keys that
+    cannot be checked one at a time are checked here."""
+    r = sc.render
+    if r.camera in ("trace", "walking") and sc.sensor.model == "foreground":
+        raise ConfigError(f"sensor.model = 'foreground' needs a static, shaking or still camera, not render.camera = "
+                          f"{r.camera!r}")
+    if r.camera != "trace":
+        return None
+    if not r.trace:
+        raise ConfigError("render.trace: render.camera = 'trace' needs a camera-motion file (BoT-SORT's GMC format)")
+    from mtt_sim.sim2real.motion import read_warps
+
+    try:
+        warps = read_warps(r.trace)
+    except ValueError as err:
+        raise ConfigError(f"render.trace = {r.trace!r}: {err}") from None
+    det = np.linalg.det(warps[:, :, :2])
+    bad = np.flatnonzero(~(det > 1e-3))
+    if len(bad):
+        raise ConfigError(f"render.trace = {r.trace!r}: camera trace {r.trace}, frame {bad[0]}: the warp "
+                          f"{warps[bad[0]].ravel().tolist()} flips or flattens the image (determinant {det[bad[0]]:g}; "
+                          "a camera's is near 1)")
+    return warps

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from mtt_sim.sim.render import draw_fixed, fixed_point
+from mtt_sim.sim.render import draw_blob, draw_fixed, fixed_point
 
 
 @dataclass(frozen=True)
@@ -92,8 +92,11 @@ def _covered(boxes: np.ndarray, depth: np.ndarray, over_boxes: np.ndarray, over_
 
 
 def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.ndarray, is_rect: np.ndarray,
-            occluder_boxes: np.ndarray, occluder_depth: np.ndarray) -> Truth:
-    """Truth for targets with drawn image boxes `boxes` (slot order, label = slot + 1)."""
+            occluder_boxes: np.ndarray, occluder_depth: np.ndarray,
+            reference: tuple[np.ndarray, np.ndarray] | None = None) -> Truth:
+    """Truth for targets with drawn image boxes `boxes` (slot order, label = slot + 1). A frame drawn and then warped
+    into the image (a warping camera) gives its `reference`: the boxes as drawn (slot order) and the warp of their
+    pixels into the image's, so that a target's unoccluded shape is warped as its label pixels were."""
     h, w = labels.shape
     clipped = clip_boxes(boxes, w, h)
     inside = np.flatnonzero((clipped[:, 2] > 0) & (clipped[:, 3] > 0))
@@ -105,16 +108,20 @@ def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.nd
     suspects = np.flatnonzero(truncated | _covered(boxes, depth, occluder_boxes, occluder_depth))
     lo = clipped[suspects, :2].astype(int)
     hi = np.minimum(np.ceil(clipped[suspects, :2] + clipped[suspects, 2:]).astype(int) + 1, (w, h))
-    local = boxes[suspects].copy()
-    local[:, :2] -= lo  # each suspect's shape in its own region of interest
-    geometry = fixed_point(local)
+    if reference is None:
+        local = boxes[suspects].copy()
+        local[:, :2] -= lo  # each suspect's shape in its own region of interest
+        geometry = fixed_point(local)
     rect = is_rect[inside[suspects]].tolist()
     pieces = []
     for k, (r, (x0, y0), (x1, y1)) in enumerate(zip(suspects.tolist(), lo.tolist(), hi.tolist())):
         mine = cv2.compare(labels[y0:y1, x0:x1], int(inside[r] + 1), cv2.CMP_EQ)
         seen = cv2.countNonZero(mine)
-        alone = np.zeros(mine.shape, np.uint8)
-        draw_fixed(alone, geometry, k, rect[k], 255)
+        if reference is None:
+            alone = np.zeros(mine.shape, np.uint8)
+            draw_fixed(alone, geometry, k, rect[k], 255)
+        else:
+            alone = _warped_shape(reference[0][inside[r]], rect[k], reference[1], x0, y0, mine.shape)
         full = cv2.countNonZero(alone)
         visibility[r] = min(1.0, seen / full) if full else 0.0
         if not seen:
@@ -133,3 +140,16 @@ def measure(labels: np.ndarray, ids: np.ndarray, boxes: np.ndarray, depth: np.nd
                  visible_boxes=visible.astype(np.float32), depth=depth.astype(np.float32),
                  labels=inside + 1, pieces=np.concatenate(pieces).astype(np.float32) if pieces else np.zeros((0, 5), np.float32))
 
+
+
+def _warped_shape(box: np.ndarray, is_rect: bool, warp: np.ndarray, x0: int, y0: int, shape: tuple) -> np.ndarray:
+    """The pixels (255) that a target drawn as `box` covers alone once `warp` (drawn pixels to image pixels) takes it
+    into the image, in the image region of `shape` whose top-left pixel is (x0, y0); nearest neighbour, as the label
+    map is warped."""
+    bx, by = int(np.floor(box[0])) - 1, int(np.floor(box[1])) - 1
+    drawn = np.zeros((int(np.ceil(box[3])) + 3, int(np.ceil(box[2])) + 3), np.uint8)
+    draw_blob(drawn, (box[0] - bx, box[1] - by, box[2], box[3]), is_rect, 255)
+    lin = warp[:, :2]
+    local = np.c_[lin, lin @ (bx, by) + warp[:, 2] - (x0, y0)]
+    return cv2.warpAffine(drawn, local, (shape[1], shape[0]), flags=cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT,
+                          borderValue=0)
