@@ -97,6 +97,8 @@ def main() -> int:
         ("fit-scene", [str(b), "--sensor", f"{t}/fitted.toml", "--out", f"{t}/scene.toml", "--seeds", "1"]),
         ("run", [f"{t}/scene.toml", "--tracker", "sort", "--steps", "20"]),
         ("validate", [str(a), str(b), "--trackers", "sort", "--seeds", "1", "--out", f"{t}/validate.md"]),
+        ("motion", [str(a), str(b), "--fit", f"{t}/walkers.toml", "--plot", f"{t}/motion.png"]),
+        ("run", ["crossing", "--steps", "20", "--config", "walk.model=langevin", "world.frame_rate=14"]),
         ("check-real", [data]) if data else ("check-real", [f"{t}/no-data"], 2, "expected the shared data folder"),
         # the docs site is built from a source checkout's docs/, which no wheel holds: it must say so in one line
         ("docs", ["--out", f"{t}/site"], 2, "the docs site is built from a source checkout"),

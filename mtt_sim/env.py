@@ -96,7 +96,8 @@ class TrackingEnv(gym.Env):
             raise ValueError(f"render_mode={render_mode!r}: allowed values: None, 'rgb_array', 'human'")
         # "human" needs pygame and a display: where they are missing it is left out of this env's modes (so
         # Gymnasium's check_env checks the modes that work here), and asking for it says how to get it
-        self.metadata = {**self.metadata, "render_modes": ["rgb_array"] + (["human"] if viewer.available() else [])}
+        self.metadata = {**self.metadata, "render_modes": ["rgb_array"] + (["human"] if viewer.available() else []),
+                         "render_fps": self.source.frame_rate}  # the source's own clock: videos play at its speed
         if render_mode == "human" and "human" not in self.metadata["render_modes"]:
             raise gym.error.DependencyNotInstalled(viewer.HOW)
         self.render_mode = render_mode

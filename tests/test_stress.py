@@ -19,7 +19,8 @@ def test_a_key_names_one_value_of_the_scenario_with_its_type_and_range():
     assert scenario.setting_of("sensor.pd")[0] is float and scenario.setting_of("sensor.pd")[1]["hi"] == 1.0
     assert scenario.setting_of("groups.0.count")[0] is int
     assert scenario.setting_of("groups.3.size.1")[0] is float  # the item's existence is the scenario's business
-    assert scenario.setting_of("render.camera")[1]["choices"] == ("static", "pan", "follow", "shake")
+    assert scenario.setting_of("render.camera")[1]["choices"] == ("static", "pan", "follow", "shake", "trace", "walking",
+                                                                "still")
     for key, message in [("sensor.pdd", "no key sensor.pdd; allowed: sensor.model"),
                          ("groups.x.count", "groups is a list: expected an item's index, got 'x'"),
                          ("sensor", "a table or a list"), ("groups.0.size.2", "expected an item's index, got '2'"),

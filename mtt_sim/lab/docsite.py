@@ -47,6 +47,7 @@ NAV = [("Home", "index.md"),
                    ("LMB (Jiang and Yang)", "lmb.md")]),
        ("Real data", [("Real sequences and the digital twin", "real_data.md"),
                       ("The sim-to-real check", "validate.md"),
+                      ("How people and cameras move", "motion.md"),
                       ("Detector presets", "detectors.md")]),
        ("Performance", "performance.md"),
        ("Tests", "tests.md")]

@@ -11,6 +11,7 @@ pixel coordinates onto this frame's, BoT-SORT's convention, in box coordinates (
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -246,3 +247,29 @@ def fit(traces, still: bool = False, period: float = 40.0, frames: int = 20000) 
             "camera_turn": round(math.degrees(scale[2]), 4), "camera_turn_corr": round(float(corr[2]), 3),
             "camera_zoom": round(float(scale[3]) * 100, 4), "camera_zoom_corr": round(float(corr[3]), 3),
             "camera_tail": tail}
+
+
+def read_warps(path: str | Path) -> np.ndarray:
+    """The (frames, 2, 3) warps of a BoT-SORT GMC file (a line a frame: its 0-based index, then a00 a01 a02 a10 a11
+    a12), or a ValueError naming the file and the row."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except OSError as err:
+        raise ValueError(f"camera trace {path}: {err.strerror}") from None
+    warps = []
+    for row, line in enumerate(lines, 1):
+        fields = line.split()
+        if not fields:
+            continue
+        try:
+            numbers = [float(f) for f in fields]
+        except ValueError:
+            raise ValueError(f"camera trace {path}, row {row}: {line.strip()!r} is not numbers") from None
+        if len(numbers) != 7 or numbers[0] != len(warps) or not np.isfinite(numbers).all():
+            raise ValueError(f"camera trace {path}, row {row}: expected the frame index {len(warps)} and six finite "
+                             f"numbers (a00 a01 a02 a10 a11 a12), got {line.strip()!r}")
+        warps.append(np.reshape(numbers[1:], (2, 3)))
+    if not warps:
+        raise ValueError(f"camera trace {path}: no warp in it")
+    return np.array(warps)

@@ -90,6 +90,23 @@ class OccluderConfig:
 
 
 @dataclass(frozen=True)
+class WalkConfig:
+    """People who walk like people (`mtt_sim.sim.walkers`): a Langevin velocity relaxing toward a desired velocity
+    toward the goal, with stops; in body heights and seconds. The defaults are fitted to the still cameras of MOT17-02
+    and MOT17-09 (`mtt-sim motion SEQ... --fit FILE`)."""
+
+    model: str = setting("off", "off: every group moves by its own `motion`; langevin: every group not carried walks by "
+                         "this model instead (one key switches a scene between the two)", choices=("off", "langevin"))
+    speed: float = setting(0.32, "median desired walking speed", "heights/s", 0.0, 10.0)
+    speed_jitter: float = setting(0.54, "spread of the desired speeds between people (log-normal sigma)", "", 0.0, 2.0)
+    relax: float = setting(1.0, "time the velocity takes to relax toward the desired one", "s", 0.01, 100.0)
+    noise: float = setting(0.079, "strength of the velocity noise", "heights/s/sqrt(s)", 0.0, 10.0)
+    stand_noise: float = setting(10.0, "how many times weaker the noise is while a person stands", "", 1.0, 1000.0)
+    stop_rate: float = setting(0.131, "rate at which a walking person stops", "1/s", 0.0, 100.0)
+    go_rate: float = setting(0.184, "rate at which a standing person walks on", "1/s", 0.0, 100.0)
+
+
+@dataclass(frozen=True)
 class WorldConfig:
     """The pymunk world: its size, projection, walls, collisions and population limits."""
 
@@ -102,6 +119,8 @@ class WorldConfig:
                           65535)
     max_births: int = setting(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
     far_scale: float = setting(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
+    frame_rate: float = setting(25.0, "frames per second of the simulated video: the walking model's seconds and the "
+                                "env's clock follow it (the other motion keys are per frame)", "1/s", 1.0, 240.0)
     carry_frames: int = setting(0, "topdown: a target completely covered by a moving target of a higher layer rides with it "
                                 "for this many frames and is then left where it is (Liu et al.'s Fig. 14: a book carried under another); 0 = never",
                              "frames", 0, 100000)
@@ -283,6 +302,7 @@ class Scenario:
     name: str = setting("Custom", "CamelCase name; the env id is mtt_sim/<name>-v0")
     description: str = setting("", "one paragraph: what it models and which experiment it mirrors")
     world: WorldConfig = table(WorldConfig, "the pymunk world")
+    walk: WalkConfig = table(WalkConfig, "the walking model")
     render: RenderConfig = table(RenderConfig, "the frame")
     sensor: SensorConfig = table(SensorConfig, "the detector")
     env: EnvConfig = table(EnvConfig, "the Gym face")

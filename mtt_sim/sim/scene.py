@@ -13,19 +13,17 @@ from mtt_sim.sim.sensor import Detections, Sensor, make_sensor
 from mtt_sim.sim.truth import Truth, measure
 from mtt_sim.sim.world import World
 
-FRAME_RATE = 25.0  # frames per second of simulated video
-
 
 class Scene:
     """One scenario's world, renderer and detector, rebuilt at every reset from the generators it is given."""
 
     length = None  # a scene ends when its world does (or at env.max_steps)
     scored = True
-    frame_rate = FRAME_RATE
     detection_dtype = np.float32
 
     def __init__(self, scenario: Scenario):
         self.config = scenario
+        self.frame_rate = scenario.world.frame_rate
         self.image_size = (scenario.render.width, scenario.render.height)
         self.world: World | None = None
         self.renderer: Renderer | None = None
@@ -103,7 +101,7 @@ def _trace(sc: Scenario) -> np.ndarray | None:
         return None
     if not r.trace:
         raise ConfigError("render.trace: render.camera = 'trace' needs a camera-motion file (BoT-SORT's GMC format)")
-    from mtt_sim.sim2real.motion import read_warps
+    from mtt_sim.sim.camera import read_warps
 
     try:
         warps = read_warps(r.trace)

@@ -21,6 +21,7 @@ import pymunk
 import pymunk.batch as pbatch
 
 from mtt_sim.sim.config import MOTIONS, TEXTURES, Scenario
+from mtt_sim.sim.walkers import Walkers
 
 WALL_BIT = 1 << 31
 _FREE, _FOR_GOOD, _LEFT = 0, -1, -2  # carry_left beside the frames left to ride: free, a carried group's, just left
@@ -56,7 +57,8 @@ class World:
         n_cols = {"ids": np.int64, "group": np.intp, "pos": (np.float64, 2), "vel": (np.float64, 2),
                   "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
                   "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64,
-                  "carry_offset": (np.float64, 2), "carry_left": np.int64, "own_vel": (np.float64, 2)}
+                  "carry_offset": (np.float64, 2), "carry_left": np.int64, "own_vel": (np.float64, 2),
+                  "desired": np.float64}
         self._cols = list(n_cols)
         for name, spec_ in n_cols.items():
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
@@ -75,6 +77,7 @@ class World:
         self._param = {k: np.array([getattr(x, k) for x in g], float)
                        for k in ("accel", "speed", "max_speed", "turn_prob", "stop_prob")}
         self._exits = [d for d in scenario.doors if d.role in ("exit", "both")]
+        self._walk = Walkers(scenario.walk, scenario.world.frame_rate) if scenario.walk.model == "langevin" else None
         self._populate()
         self._sync_order()
 
@@ -182,13 +185,17 @@ class World:
         size = np.array(g.size) * np.exp(g.size_jitter * self.rng.normal(size=2))
         hue = self._hue0 + 0.618034 * self.next_id
         color = (1 - g.similarity) * hue_colors(np.array([hue]))[0] + g.similarity * np.array(g.color)
+        phase, goal = self.rng.uniform(0, 2 * math.pi), self._pick_goal(pos)
+        desired = 0.0
+        if self._walk is not None and carrier is None:  # a walker sets off toward its goal at its own speed
+            desired = self._walk.desired_speed(self.rng)
+            vel = (goal - pos) / max(np.hypot(*(goal - pos)), 1e-9) * desired * size[1] * self._walk.dt
         self._pending.append(dict(
             ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
-            cruise=float(np.hypot(*vel)) or g.speed, phase=self.rng.uniform(0, 2 * math.pi),
-            goal=self._pick_goal(pos), stopped=False, born=self.t,
+            cruise=float(np.hypot(*vel)) or g.speed, phase=phase, goal=goal, stopped=False, born=self.t,
             carrier_id=0 if carrier is None else int(self.ids[carrier]),
             carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier],
-            carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel))
+            carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel, desired=desired))
         self.next_id += 1
         self.bodies.append(self._make_body(g, pos, vel, size, carrier))
         return size
@@ -345,7 +352,12 @@ class World:
         return pymunk.ShapeFilter(categories=layer_bit, mask=mask)
 
     def _apply_motion(self):
-        """Update `vel` (ground velocity, px/frame) of every target by its group's motion model."""
+        """Update `vel` (ground velocity, px/frame) of every target by its group's motion model, or by the walking
+        model where the scene has one (`walk.model`)."""
+        if self._walk is not None:
+            self.vel, self.stopped = self._walk.step(self.vel, self.pos, self.goal, self.desired, self.size[:, 1],
+                                                     self.stopped, self.rng)
+            return
         g, p = self.group, self._param
         motion = self._motion[g]
         noise = self.rng.normal(size=(len(g), 2))

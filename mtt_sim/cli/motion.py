@@ -1,0 +1,106 @@
+"""`mtt-sim motion`: how the people of sequences and scenarios move, and how camera traces move, side by side, so that
+a simulated world is held against real ones by the same numbers."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+from pathlib import Path
+
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, add_dry_run, add_overrides, dry_run, episode_overrides,
+                                   estimate, integer, loaded, output_file, replaced, scenario_key)
+
+
+def trace_file(text: str) -> str:
+    """A camera trace in BoT-SORT's GMC format, read whole (a bad row is named)."""
+    from mtt_sim.sim2real.motion import read_warps
+
+    try:
+        read_warps(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    return text
+
+
+def image_size(text: str) -> tuple[int, int]:
+    """WIDTHxHEIGHT in pixels, e.g. 1920x1080."""
+    width, sep, height = text.lower().partition("x")
+    if not (sep and width.isdigit() and height.isdigit() and int(width) > 0 and int(height) > 0):
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 1920x1080, got {text!r}")
+    return int(width), int(height)
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("motion", help="how people move in sequences and scenarios (speed, deviation from "
+                                             "constant velocity, standing, turning, time in view) and how camera "
+                                             "traces move, side by side")
+    p.add_argument("sources", nargs="*", type=scenario_key, metavar="SOURCE",
+                   help="sequence folders (their ground truth), scenario keys or .toml files (one episode each)")
+    p.add_argument("--trace", nargs="+", default=[], type=trace_file, metavar="FILE",
+                   help="camera traces in BoT-SORT's GMC format (a line a frame: index, then a 2x3 warp)")
+    p.add_argument("--trace-size", type=image_size, default=(1920, 1080), metavar="WxH",
+                   help="the traces' image size, for the translation as a share of the width (default 1920x1080)")
+    p.add_argument("--seed", type=integer(0), default=0, help="the scenarios' episode seed (default 0)")
+    p.add_argument("--steps", type=integer(1), help="cut each scenario's episode to this many frames")
+    p.add_argument("--plot", help="write the speed and deviation distributions as a PNG (the [plot] extra)")
+    p.add_argument("--fit", metavar="FILE.toml",
+                   help="fit the walking model to the ground truth of the sequence folders among the sources and write "
+                        "it as a [walk] table")
+    p.add_argument("--json", action="store_true", help="print the statistics as one JSON object")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
+    add_dry_run(p)
+    add_overrides(p, CONFIG_HELP + " (for the scenarios; a sequence's own people are measured as they are)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from mtt_sim.cli.arguments import UsageError, require
+
+    if not args.sources and not args.trace:
+        raise UsageError("SOURCE", "give sequence folders or scenarios, or --trace files, or both")
+    overrides = episode_overrides(args)
+    from mtt_sim.real.layout import is_sequence
+    from mtt_sim.sim2real import motion
+
+    for source in args.sources:
+        loaded([source], motion.overrides_for(source, overrides))
+    plot = output_file(args.plot, args.force, "--plot", (".png",))
+    if plot:
+        require("matplotlib", "--plot", "plot")
+    fit = output_file(args.fit, args.force, "--fit", (".toml",))
+    real = [s for s in args.sources if is_sequence(s)]
+    if fit and not real:
+        raise UsageError("--fit", "fits to real ground truth: give sequence folders (with gt/gt.txt) among the sources")
+    if dry_run(args, estimate("motion", [(len(args.sources), "episodes")], args.sources, overrides, steps=args.steps)
+               if args.sources else f"motion: {len(args.trace)} traces read"):
+        return 0
+
+    people, windows = {}, {}
+    for source in args.sources:
+        frames, frame_rate, _ = motion.scored_frames(source, overrides, args.seed, args.steps)
+        name = Path(source).stem if source.endswith(".toml") else Path(source).name
+        people[name] = motion.people(frames, frame_rate)
+        windows[name] = motion.window_values(frames, frame_rate)
+    cameras = {Path(t).stem: motion.camera(motion.read_warps(t), *args.trace_size) for t in args.trace}
+    if plot:
+        motion.plot(windows, plot)
+    if fit:
+        from mtt_sim.sim import scenario
+        from mtt_sim.sim2real import fit_walkers
+
+        fitted = fit_walkers.fit(motion.scored_frames(s, overrides)[:2] for s in real)
+        fit.write_text(scenario.to_toml({"walk": dataclasses.asdict(fitted)}, [
+            f"the walking model fitted to {', '.join(Path(s).name for s in real)} by mtt-sim motion --fit"]))
+    if args.json:
+        print(json.dumps({"people": people, "cameras": cameras}))
+        return 0
+    for title, table in (("people (one-second windows, in body heights)", people), ("cameras (per frame)", cameras)):
+        if table:
+            print(f"{title}\n\n{motion.markdown(table)}\n")
+    if plot:
+        print(f"plot: {plot}" + replaced(args.force))
+    if fit:
+        print(f"walkers: {fit}" + replaced(args.force) + "; a scene walks by them with its [walk] table, or "
+              + " ".join(f"walk.{k}={v}" for k, v in dataclasses.asdict(fitted).items()) + " as --config")
+    return 0
