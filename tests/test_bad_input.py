@@ -44,7 +44,9 @@ def inputs(tmp_path_factory) -> dict:
                        "badsensorval.toml": "[sensor]\npd = 5\n", "typo.toml": 'base = "crossing"\n[sensor]\n'
                        "clutter_rat = 3\n", "results_ok.txt": "1,1,10,10,20,40\n", "results_bad.txt":
                        "1,1,10,10,20,40\n2,1,10,10\n", "results_nonnum.txt": "1,1,10,10,20,40\n2,1,10,y,20,40\n",
-                       "badtrace.txt": "0 1 0 0 0 1 0\n1 1 0 x 0 1 0\n"}.items():
+                       "badtrace.txt": "0 1 0 0 0 1 0\n1 1 0 x 0 1 0\n",
+                       "stilltrace.txt": "0 1 0 0 0 1 0\n1 1 0 0.01 0 1 0\n",
+                       "movingtrace.txt": "0 1 0 0 0 1 0\n1 1 0 9.5 0 1 2\n"}.items():
         (root / name).write_text(text)
         found[name.split(".")[0].upper()] = str(root / name)
     np.savez(root / "bad.npz", x=np.zeros(3))
@@ -202,8 +204,10 @@ BAD_INPUTS = [
     (["motion", "crossing", "--trace", "BADTRACE"], r"argument --trace: camera trace \S*badtrace.txt, row 2: "
                                                     r"'1 1 0 x 0 1 0' is not numbers"),
     (["motion", "crossing", "--trace-size", "1920"], r"argument --trace-size: expected WIDTHxHEIGHT .*got '1920'"),
-    (["motion", "crossing", "--fit", "walk.toml"], r"argument --fit: fits to real ground truth: give sequence "
-                                                   r"folders \(with gt/gt.txt\) among the sources"),
+    (["motion", "crossing", "--fit", "walk.toml"], r"argument --fit: fits the walking model to real ground truth "
+                                                   r"and the camera to traces: give sequence folders"),
+    (["motion", "--trace", "STILLTRACE", "MOVINGTRACE", "--fit", "c.toml"], r"argument --fit: the traces mix still "
+                                                                         r"cameras \(\S*stilltrace.txt\) and moving"),
     (["motion", "OK", "--fit", "walk.txt"], r"argument --fit: 'walk.txt': the file name must end in \.toml"),
     (["motion", "crossing", "--config", "walk.model=langevn"], r"walk.model = 'langevn': allowed values: 'off', "
                                                                 r"'langevin'"),

@@ -2,12 +2,14 @@
 statistics are known, a bad trace named by its row, and the command on a tiny sequence and trace."""
 
 import json
+import tomllib
 
 import numpy as np
 import pytest
 from helpers import write_sequence
 
 from mtt_sim import cli
+from mtt_sim.sim import scenario
 from mtt_sim.sim.config import WalkConfig
 from mtt_sim.sim2real import fit_walkers, motion
 
@@ -109,3 +111,17 @@ def test_a_scene_walks_by_the_model_at_its_own_frame_rate_and_stands_as_fitted()
     for s in stats.values():  # MOT17-02 and 09, which the defaults are fitted to: 0.14, 0.066, 0.41 pooled
         assert 0.05 < s["speed"] < 0.4 and 0.03 < s["deviation"] < 0.13 and s["standing"] >= 0.15
     assert stats[10.0]["speed"] == pytest.approx(stats[25.0]["speed"], rel=0.5)  # seconds, not frames
+
+
+def test_fit_writes_the_camera_fitted_to_traces_as_keys_a_scene_takes(tmp_path, capsys):
+    rng = np.random.default_rng(3)
+    moving = tmp_path / "GMC-moving.txt"
+    steps = np.cumsum(rng.standard_t(2, (400, 2)), axis=0) * 0.3 + [2.0, 0.5]  # a drifting, heavy-tailed walk
+    moving.write_text("".join(f"{k} 1.001 0 {dx:.4f} 0 1.001 {dy:.4f}\n" for k, (dx, dy) in enumerate(steps)))
+    out = tmp_path / "camera.toml"
+    assert cli.main(["motion", "--trace", str(moving), "--fit", str(out)]) == 0
+    fitted = tomllib.loads(out.read_text())["render"]
+    assert fitted["camera"] == "walking" and set(fitted) > {"camera_step", "camera_tail", "camera_zoom"}
+    scene = scenario.load("mot17_like", {f"render.{k}": v for k, v in fitted.items()})
+    assert scene.render.camera == "walking" and list(scene.render.camera_step) == fitted["camera_step"]
+    assert "fitted: " in capsys.readouterr().out

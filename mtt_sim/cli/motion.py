@@ -45,8 +45,8 @@ def add(subparsers) -> None:
     p.add_argument("--steps", type=integer(1), help="cut each scenario's episode to this many frames")
     p.add_argument("--plot", help="write the speed and deviation distributions as a PNG (the [plot] extra)")
     p.add_argument("--fit", metavar="FILE.toml",
-                   help="fit the walking model to the ground truth of the sequence folders among the sources and write "
-                        "it as a [walk] table")
+                   help="fit the walking model to the ground truth of the sequence folders among the sources ([walk]) "
+                        "and the camera to the --trace files ([render]), and write them as TOML tables")
     p.add_argument("--json", action="store_true", help="print the statistics as one JSON object")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     add_dry_run(p)
@@ -70,8 +70,13 @@ def run(args) -> int:
         require("matplotlib", "--plot", "plot")
     fit = output_file(args.fit, args.force, "--fit", (".toml",))
     real = [s for s in args.sources if is_sequence(s)]
-    if fit and not real:
-        raise UsageError("--fit", "fits to real ground truth: give sequence folders (with gt/gt.txt) among the sources")
+    if fit and not real and not args.trace:
+        raise UsageError("--fit", "fits the walking model to real ground truth and the camera to traces: give "
+                                  "sequence folders (with gt/gt.txt) among the sources, or --trace files")
+    still = [_is_still(t, args.trace_size) for t in args.trace] if fit else []
+    if len(set(still)) > 1:
+        raise UsageError("--fit", "the traces mix still cameras (" + ", ".join(t for t, s in zip(args.trace, still) if s)
+                         + ") and moving ones: fit each kind apart")
     if dry_run(args, estimate("motion", [(len(args.sources), "episodes")], args.sources, overrides, steps=args.steps)
                if args.sources else f"motion: {len(args.trace)} traces read"):
         return 0
@@ -86,12 +91,11 @@ def run(args) -> int:
     if plot:
         motion.plot(windows, plot)
     if fit:
+        tables = _fitted(real, args.trace, args.trace_size, overrides, any(still))
         from mtt_sim.sim import scenario
-        from mtt_sim.sim2real import fit_walkers
 
-        fitted = fit_walkers.fit(motion.scored_frames(s, overrides)[:2] for s in real)
-        fit.write_text(scenario.to_toml({"walk": dataclasses.asdict(fitted)}, [
-            f"the walking model fitted to {', '.join(Path(s).name for s in real)} by mtt-sim motion --fit"]))
+        fit.write_text(scenario.to_toml(tables, ["fitted by mtt-sim motion --fit to " + ", ".join(
+            Path(s).name for s in [*real, *args.trace])]))
     if args.json:
         print(json.dumps({"people": people, "cameras": cameras}))
         return 0
@@ -101,6 +105,31 @@ def run(args) -> int:
     if plot:
         print(f"plot: {plot}" + replaced(args.force))
     if fit:
-        print(f"walkers: {fit}" + replaced(args.force) + "; a scene walks by them with its [walk] table, or "
-              + " ".join(f"walk.{k}={v}" for k, v in dataclasses.asdict(fitted).items()) + " as --config")
+        keys = [f"{table}.{k}={json.dumps(v)}" for table, values in tables.items() for k, v in values.items()]
+        print(f"fitted: {fit}" + replaced(args.force) + f" ({' and '.join(f'[{t}]' for t in tables)}); a scene takes "
+              f"them as its own tables, or as --config {' '.join(keys)}")
     return 0
+
+
+STILL = 3e-4  # a trace whose image centre moves a median share of the width below this is a still camera's
+
+
+def _is_still(trace: str, size: tuple[int, int]) -> bool:
+    from mtt_sim.sim2real import motion
+
+    return motion.camera(motion.read_warps(trace), *size)["translation median (width)"] < STILL
+
+
+def _fitted(sequences: list[str], traces: list[str], size: tuple[int, int], overrides: dict, still: bool) -> dict:
+    """The [walk] table fitted to the sequences' ground truth and the [render] camera keys fitted to the traces:
+    the still camera's where they are `still`, else the walking camera's."""
+    from mtt_sim.sim import camera
+    from mtt_sim.sim2real import fit_walkers, motion
+
+    tables = {}
+    if sequences:
+        tables["walk"] = dataclasses.asdict(fit_walkers.fit(motion.scored_frames(s, overrides)[:2] for s in sequences))
+    if traces:
+        warps = [(motion.read_warps(t), *size) for t in traces]
+        tables["render"] = {"camera": "still" if still else "walking", **camera.fit(warps, still=still)}
+    return tables
