@@ -88,6 +88,9 @@ def test_the_command_prints_people_and_cameras_side_by_side(tmp_path, capsys):
     assert out["people"]["walk"]["speed"] == pytest.approx(0.4) and out["people"]["walk"]["standing"] == 0
     assert out["cameras"]["GMC-cam"]["translation median (px)"] == pytest.approx(5.0)
     assert cli.main(["motion"]) == 2 and "give sequence folders or scenarios" in capsys.readouterr().err
+    assert cli.main(["motion", "mot17_moving", "crossing", "--steps", "60", "--json"]) == 0
+    cameras = json.loads(capsys.readouterr().out)["cameras"]  # a scene's own camera, from its warps
+    assert cameras["crossing"]["translation p95 (px)"] == 0 and cameras["mot17_moving"]["translation median (px)"] > 0.5
 
 
 def test_the_walking_model_fitted_to_its_own_walkers_shows_their_statistics_again():

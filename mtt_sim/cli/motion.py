@@ -81,13 +81,16 @@ def run(args) -> int:
                if args.sources else f"motion: {len(args.trace)} traces read"):
         return 0
 
-    people, windows = {}, {}
+    people, windows, cameras = {}, {}, {}
     for source in args.sources:
-        frames, frame_rate, _ = motion.scored_frames(source, overrides, args.seed, args.steps)
+        warps = []
+        frames, frame_rate, size = motion.scored_frames(source, overrides, args.seed, args.steps, warps)
         name = Path(source).stem if source.endswith(".toml") else Path(source).name
         people[name] = motion.people(frames, frame_rate)
         windows[name] = motion.window_values(frames, frame_rate)
-    cameras = {Path(t).stem: motion.camera(motion.read_warps(t), *args.trace_size) for t in args.trace}
+        if warps:  # a simulated scene's own camera
+            cameras[name] = motion.camera(warps, *size)
+    cameras.update({Path(t).stem: motion.camera(motion.read_warps(t), *args.trace_size) for t in args.trace})
     if plot:
         motion.plot(windows, plot)
     if fit:

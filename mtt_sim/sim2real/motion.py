@@ -109,15 +109,20 @@ def overrides_for(source: str, config: dict | None) -> dict:
                                            if k.split(".")[0] in ("env", "scoring")}}
 
 
-def scored_frames(source: str, config: dict | None = None, seed: int = 0, steps: int | None = None):
+def scored_frames(source: str, config: dict | None = None, seed: int = 0, steps: int | None = None,
+                  warps: list | None = None):
     """Each frame's scored (ids, boxes) of `source` (a scenario, a .toml file or a sequence folder) over one episode
-    without a tracker with `config` (see `overrides_for`), and its frame rate and image size."""
+    without a tracker with `config` (see `overrides_for`), and its frame rate and image size. A simulated scene's
+    camera warps, frame by frame, are appended to `warps` where it is given."""
     from mtt_sim.env import TrackingEnv  # heavy: imported where needed
     from mtt_sim.lab.episode import Episode
 
     env = TrackingEnv(source, config=overrides_for(source, config), obs_mode="detections")
-    no_tracks = np.zeros((0, 4))
-    frames = [env.source.scored_truth(no_tracks)[:2] for _ in Episode(env, seed, steps=steps)]
+    no_tracks, frames = np.zeros((0, 4)), []
+    for _ in Episode(env, seed, steps=steps):
+        frames.append(env.source.scored_truth(no_tracks)[:2])
+        if warps is not None and hasattr(env.source, "camera_warp"):
+            warps.append(env.source.camera_warp)
     return frames, env.source.frame_rate, env.source.image_size
 
 
