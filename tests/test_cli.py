@@ -16,7 +16,7 @@ from mtt_sim import trackers
 from mtt_sim import cli
 from mtt_sim.cli import arguments
 from mtt_sim.lab import docsite, experiment
-from mtt_sim.lab import perf
+from mtt_sim.lab import perf, perf_motion
 from mtt_sim.sim import scenario
 
 
@@ -278,6 +278,14 @@ def test_config_reference_and_perf_report_shape(capsys):
     assert [c[0] for c in cells] == [r["tracker"] for r in rows] and all(_is_ratio(c[3], c[1], c[2]) for c in cells)
 
 
+def test_perf_motion_table_has_each_stage_of_each_case():
+    rows = perf_motion.measure_motion(repeats=1, steps=2)
+    assert [(r["scenario"], r["motion"]) for r in rows] == [c[:2] for c in perf_motion.CASES]
+    header, cells = _table(perf_motion.report_motion(rows))
+    assert header == ["scenario", "motion", "steps/s", *perf.STAGES] and len(cells) == len(rows)
+    assert all(min(r[k] for k in ("world", "render")) > 0 for r in rows)
+
+
 def test_perf_tables_of_scenarios_scaling_rfs_trackers_and_sweeps():
     rows = perf.measure_scenarios(repeats=1, steps=2)
     assert [r["scenario"] for r in rows] == sorted(scenario.available())
@@ -337,14 +345,15 @@ def test_plot_intervals_stop_at_what_the_metric_can_take():
 
 
 def test_perf_shows_its_progress_and_prints_each_table(monkeypatch, capsys):
-    for name in dir(perf):
-        if name.startswith("measure"):
-            monkeypatch.setattr(perf, name, lambda repeats, steps=None, name=name: name)
-        elif name.startswith("report"):
-            monkeypatch.setattr(perf, name, lambda measured: f"table of {measured}")
+    for module in (perf, perf_motion):
+        for name in dir(module):
+            if name.startswith("measure"):
+                monkeypatch.setattr(module, name, lambda repeats, steps=None, name=name: name)
+            elif name.startswith("report"):
+                monkeypatch.setattr(module, name, lambda measured: f"table of {measured}")
     assert cli.main(["perf", "--repeats", "1"]) == 0
     captured = capsys.readouterr()
-    assert captured.out.count("table of measure") == 11 and "measuring" in captured.err
+    assert captured.out.count("table of measure") == 12 and "measuring" in captured.err
     assert cli.main(["perf", "--repeats", "1", "--sections", "baselines,jpda"]) == 0
     assert capsys.readouterr().out.split() == ["table", "of", "measure_jpda", "table", "of", "measure_baselines"]
     with pytest.raises(SystemExit):

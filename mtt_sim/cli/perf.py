@@ -18,7 +18,7 @@ def add(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-SECTIONS = ("env", "scenarios", "scaling", "metrics", "metrics memory", "jpda", "lmb", "rfs", "baselines",
+SECTIONS = ("env", "scenarios", "scaling", "motion", "metrics", "metrics memory", "jpda", "lmb", "rfs", "baselines",
             "particle filters", "sweeps")
 
 
@@ -36,11 +36,12 @@ def run(args) -> int:
         return 0
     from tqdm import tqdm
 
-    from mtt_sim.lab import perf
+    from mtt_sim.lab import perf, perf_motion
 
     sections = [("env", lambda: perf.report(perf.measure(repeats=args.repeats, steps=args.steps))),
                 ("scenarios", lambda: perf.report_scenarios(perf.measure_scenarios(repeats=args.repeats, steps=args.steps))),
                 ("scaling", lambda: perf.report_scaling(perf.measure_scaling(repeats=args.repeats))),
+                ("motion", lambda: perf_motion.report_motion(perf_motion.measure_motion(args.repeats, args.steps))),
                 ("metrics", lambda: perf.report_metrics(perf.measure_metrics(repeats=args.repeats))),
                 ("metrics memory", lambda: perf.report_metrics_memory(perf.measure_metrics_memory(repeats=args.repeats))),
                 ("jpda", lambda: perf.report_jpda(perf.measure_jpda(repeats=args.repeats))),

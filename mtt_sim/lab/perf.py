@@ -85,7 +85,7 @@ def measure(repeats: int = 5, steps: int = 200) -> list[dict]:
     return rows
 
 
-def _table(title: str, columns: list[str], rows: list[list], left: int = 0) -> str:
+def markdown_table(title: str, columns: list[str], rows: list[list], left: int = 0) -> str:
     """A markdown table under a title line; the first `left` columns are aligned left, the others right."""
     lines = [title, "| " + " | ".join(columns) + " |",
              "|" + "|".join("---" if i < left else "---:" for i in range(len(columns))) + "|"]
@@ -94,7 +94,7 @@ def _table(title: str, columns: list[str], rows: list[list], left: int = 0) -> s
 
 def report(rows: list[dict]) -> str:
     """Markdown table of `measure`'s rows."""
-    return _table(f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background "
+    return markdown_table(f"env step throughput at {SIZE[0]}x{SIZE[1]} ('dense' scenario), medians; reference: background "
                   "copy and two filled ellipses per target (frame and label map)",
                   ["targets", "steps/s with frames", "steps/s detections only", "reference frames/s",
                    "step / reference"],
@@ -117,7 +117,7 @@ def measure_scenarios(repeats: int = 5, steps: int = 200) -> list[dict]:
 
 
 def report_scenarios(rows: list[dict]) -> str:
-    return _table("env step throughput per scenario with frames and detections, medians (reference: as above, its "
+    return markdown_table("env step throughput per scenario with frames and detections, medians (reference: as above, its "
                   "own targets of the first frame)",
                   ["scenario", "image", "targets (first frame)", "steps/s", "reference frames/s", "step / reference"],
                   [[r["scenario"], r["image"], r["targets"], f"{r['steps_per_s']:.0f}", f"{r['reference_per_s']:.0f}",
@@ -127,7 +127,7 @@ def report_scenarios(rows: list[dict]) -> str:
 STAGES = ("world", "render", "truth", "detector", "scoring", "other")
 
 
-def _stage_seconds(env: TrackingEnv, steps: int) -> dict[str, float]:
+def stage_seconds(env: TrackingEnv, steps: int) -> dict[str, float]:
     """Seconds per step of each stage of env.step, timed by wrapping the env's parts: the world's physics and motion,
     the renderer (frame and label map), the truth's visibility, the detector, the scoring and the rest."""
     spent: Counter = Counter()
@@ -161,7 +161,7 @@ def measure_scaling(repeats: int = 5, steps: int = 100) -> list[dict]:
     for size in (SIZE, (1920, 1080)):
         for n in (20, 200, 2000):
             env = _env(n, "frame+detections", size)
-            runs = [_stage_seconds(env, max(int(steps * (20 / n) ** 0.5), 10)) for _ in range(repeats)]
+            runs = [stage_seconds(env, max(int(steps * (20 / n) ** 0.5), 10)) for _ in range(repeats)]
             rows.append({"targets": n, "image": f"{size[0]}x{size[1]}", "pixels": size[0] * size[1],
                          **{k: statistics.median(r[k] for r in runs) * 1e3 for k in (*STAGES, "total")}})
     return rows
@@ -177,7 +177,7 @@ def report_scaling(rows: list[dict]) -> str:
     small, large = f"{SIZE[0]}x{SIZE[1]}", "1920x1080"
     pixels = by[(200, large)]["pixels"] / by[(200, small)]["pixels"]
     return "\n".join([
-        _table("env step cost by stage, milliseconds per step with frames, medians ('dense'; above 200 targets the "
+        markdown_table("env step cost by stage, milliseconds per step with frames, medians ('dense'; above 200 targets the "
                "blobs shrink to keep the share of the image they cover)", ["targets", "image", "steps/s", *STAGES],
                [[r["targets"], r["image"], f"{1e3 / r['total']:.0f}", *(f"{r[k]:.2f}" for k in STAGES)] for r in rows]),
         f"growth, 200 -> 2000 targets (10x) at {small}: " + _growth(by[(200, small)], by[(2000, small)]),
@@ -227,7 +227,7 @@ def measure_metrics(repeats: int = 5) -> list[dict]:
 
 def report_metrics(rows: list[dict]) -> str:
     """Markdown table of `measure_metrics`' rows."""
-    return _table("EpisodeMetrics cost, medians (reference: IoU matrix + one Hungarian assignment per frame)",
+    return markdown_table("EpisodeMetrics cost, medians (reference: IoU matrix + one Hungarian assignment per frame)",
                   ["objects", "frames", "update per frame", "reference per frame", "update / reference",
                    "summary of all frames"],
                   [[r["objects"], r["frames"], f"{r['update_us']:.0f} us", f"{r['reference_us']:.0f} us",
@@ -252,7 +252,7 @@ def measure_metrics_memory(repeats: int = 5, objects: int = 200, frames: int = 3
 
 
 def report_metrics_memory(row: dict) -> str:
-    return _table("EpisodeMetrics memory of a long episode (summary time: median)",
+    return markdown_table("EpisodeMetrics memory of a long episode (summary time: median)",
                   ["objects", "frames", "stored per frame", "summary", "summary peak / stored"],
                   [[row["objects"], row["frames"], f"{row['kb_per_frame']:.1f} KB", f"{row['summary_s']:.2f} s",
                     f"{row['peak_over_stored']:.2f}x"]])
@@ -283,7 +283,7 @@ def measure_jpda(repeats: int = 5, frames: int = 150) -> list[dict]:
 
 
 def report_jpda(rows: list[dict]) -> str:
-    table = _table("jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
+    table = markdown_table("jpda tracker time per frame, medians (P_D 0.9, 5 clutter a frame, detections only; reference: gnn)",
                    ["targets", "jpda ms/frame", "gnn ms/frame", "jpda / gnn"],
                    [[r["targets"], f"{r['jpda_ms']:.2f}", f"{r['gnn_ms']:.2f}", f"{r['jpda_over_gnn']:.2f}x"]
                     for r in rows])
@@ -306,7 +306,7 @@ def measure_lmb(repeats: int = 5, frames: int = 100) -> list[dict]:
 
 
 def report_lmb(rows: list[dict]) -> str:
-    return _table("lmb tracker time per frame, medians (P_D 0.9, 10 clutter a frame; reference: gnn on the same "
+    return markdown_table("lmb tracker time per frame, medians (P_D 0.9, 10 clutter a frame; reference: gnn on the same "
                   "detections)", ["targets", "detections/frame", "lmb:reid=false ms/frame", "lmb (re-id) ms/frame",
                                   "gnn ms/frame", "lmb:reid=false / gnn"],
                   [[r["targets"], f"{r['detections']:.1f}", f"{r['lmb_ms']:.2f}", f"{r['lmb_reid_ms']:.2f}",
@@ -347,7 +347,7 @@ def measure_baselines(repeats: int = 5, frames: int = 300, workloads=BASELINE_WO
 
 def report_baselines(rows: list[dict]) -> str:
     peer = not all(np.isnan(r["roboflow_fps"]) for r in rows)
-    return _table("published baselines, tracker time only, medians (reference: Roboflow's same tracker, "
+    return markdown_table("published baselines, tracker time only, medians (reference: Roboflow's same tracker, "
                   + ("trackers " + metadata_version("trackers") if peer else "not installed: the [peers] extra")
                   + ")", ["tracker", "workload", "frames/s", "Roboflow frames/s", "ours / Roboflow"],
                   [[r["tracker"], r["workload"], f"{r['fps']:.0f}"]
@@ -383,7 +383,7 @@ def measure_rfs(repeats: int = 5, frames: int = 100) -> list[dict]:
 
 
 def report_rfs(rows: list[dict]) -> str:
-    return _table("random-finite-set trackers on scenarios, tracker time only, medians (reference: gnn on the same "
+    return markdown_table("random-finite-set trackers on scenarios, tracker time only, medians (reference: gnn on the same "
                   "detections)", ["tracker", "workload", "ms/frame", "frames/s", "gnn ms/frame", "tracker / gnn"],
                   [[r["tracker"], r["workload"], f"{r['ms']:.2f}", f"{1e3 / r['ms']:.0f}", f"{r['gnn_ms']:.2f}",
                     f"{r['over_gnn']:.2f}x"] for r in rows], left=2)
@@ -452,7 +452,7 @@ def measure_pf(repeats: int = 5, frames: int = 60) -> list[dict]:
 
 
 def report_pf(rows: list[dict]) -> str:
-    return _table("particle filters, tracker time only, medians",
+    return markdown_table("particle filters, tracker time only, medians",
                   ["tracker", "frames/s", "per-particle calcHist frames/s (its histogram only)", "tracker / reference"],
                   [[r["tracker"], f"{r['fps']:.0f}", f"{r['reference_fps']:.0f}",
                     f"{r['fps'] / r['reference_fps']:.2f}x"] for r in rows], left=1)
@@ -473,6 +473,6 @@ def measure_sweeps(repeats: int = 3, config: dict | None = None) -> dict:
 
 def report_sweeps(row: dict) -> str:
     specs, scenarios, seeds = SWEEP
-    return _table(f"bench grid ({', '.join(specs)} on {', '.join(scenarios)}, {seeds} seeds: {row['episodes']} "
+    return markdown_table(f"bench grid ({', '.join(specs)} on {', '.join(scenarios)}, {seeds} seeds: {row['episodes']} "
                   "episodes), wall time, medians", ["1 worker", "2 workers", "speed-up"],
                   [[f"{row['one_s']:.1f} s", f"{row['two_s']:.1f} s", f"{row['speedup']:.2f}x"]])
