@@ -48,7 +48,7 @@ def fitted(folder):
 def test_estimates_equal_the_known_answers(tmp_path):
     raw, rows, info = fitted(write_sequence(tmp_path / "seq", walkers(), size=(W, H)))
     g = raw["groups"][0]
-    assert (raw["render"], raw["env"]) == ({"width": W, "height": H}, {"max_steps": FRAMES})
+    assert (raw["render"], raw["env"]) == ({"width": W, "height": H, "camera": "still"}, {"max_steps": FRAMES})
     assert raw["world"]["projection"] == "standing"
     assert raw["world"]["far_scale"] == pytest.approx(A / NEAR, abs=1e-3)  # exact boxes: the line is exact
     assert g["size"] == pytest.approx([0.4 * NEAR, NEAR], abs=0.1)          # rounded to 0.1 px
@@ -73,7 +73,7 @@ def test_a_late_person_is_a_birth_and_opposite_walkers_go_any_way(tmp_path):
 
 def test_heights_that_do_not_grow_downward_make_a_topdown_world(tmp_path):
     raw, _, _ = fitted(write_sequence(tmp_path / "seq", walkers(heights=[50.0] * 5), size=(W, H)))
-    assert raw["world"] == {"projection": "topdown"} and raw["groups"][0]["size"] == [20.0, 50.0]
+    assert raw["world"] == {"projection": "topdown", "frame_rate": 10.0} and raw["groups"][0]["size"] == [20.0, 50.0]
 
 
 def test_ground_truth_is_never_read(tmp_path, sensor):
@@ -120,3 +120,79 @@ def test_the_command_writes_refuses_and_checks(tmp_path, sensor, capsys):
         cli.main(["fit-scene", str(tmp_path), "--sensor", str(sensor), "--out", str(tmp_path / "other.toml")])
     err = capsys.readouterr().err
     assert stop.value.code == 2 and err.count("\n") == 1 and "det/det.txt" in err
+
+
+# ---------------------------------------------------------------- how the scene moves (fit_motion)
+
+RATE, LONG = 10, 80          # write_sequence's seqinfo says 10 frames a second; 8 seconds
+TALL = 100.0                 # px: every box's height
+STEP = 0.5 * TALL / RATE     # px a frame: people walk half a height a second
+
+
+def camera_path(frames=LONG, seed=3):
+    """A hand-held camera's shift each frame (px; frame 1 none): a sway of 4 px a frame back and forth over two
+    seconds, plus jitter."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(frames)
+    shift = np.c_[4.0 * np.sin(2 * np.pi * k / (2 * RATE)), 2.0 * np.cos(2 * np.pi * k / (1.3 * RATE))]
+    shift += rng.normal(0, 1.5, (frames, 2))
+    shift[0] = 0.0
+    return shift
+
+
+def moving_people(shift=None, standing=0):
+    """Eight people, each in every frame: two walking right, two left, two up, two down at STEP px a frame (the last
+    `standing` of them stand instead), all seen through a camera that moves by `shift` a frame."""
+    path = np.cumsum(shift, axis=0) if shift is not None else np.zeros((LONG, 2))
+    ways = [(1, 0), (1, 0), (-1, 0), (-1, 0), (0, 1), (0, 1), (0, -1), (0, -1)]
+    starts = [(100, 150), (150, 330), (500, 200), (520, 360), (260, 60), (380, 90), (300, 300), (420, 330)]
+    rows = []
+    for i, ((dx, dy), (x0, y0)) in enumerate(zip(ways, starts)):
+        v = 0.0 if i >= len(ways) - standing else STEP
+        for f in range(LONG):
+            x, y = x0 + dx * v * f + path[f, 0], y0 + dy * v * f + path[f, 1]
+            rows.append((f + 1, float(x), float(y), 0.4 * TALL, TALL, 0.9))
+    return rows
+
+
+def test_a_camera_that_moves_is_told_apart_from_the_people(tmp_path):
+    from mtt_sim.sim2real import fit_motion
+
+    shift = camera_path()
+    rows, info = fit_scene.link_sequence(write_sequence(tmp_path / "seq", moving_people(shift), size=(W, H)))
+    moved = fit_motion.fit(rows, info)
+    cam = moved["camera"]
+    assert cam["moving"] and cam["r"] > 0.5
+    # the shift a frame (px) recovered, as SORT's filter passes it on (it smooths the jitter a little)
+    assert all(np.corrcoef(cam["shift"][1:, c], shift[1:, c])[0, 1] > 0.9 for c in (0, 1))
+    assert np.median(np.abs(cam["shift"][1:] - shift[1:])) < 0.8
+    assert moved["render"]["camera"] == "walking" and moved["render"]["camera_step"][0] > 0
+    # the people's own motion, the camera taken out: half a height a second in straight lines (seen through the
+    # camera, they would be fitted at 0.6 heights a second with a noise of 0.58)
+    assert moved["walk"]["speed"] == pytest.approx(0.5, rel=0.1) and moved["walk"]["noise"] < 0.1
+    stable = fit_motion.stabilise(fit_motion.track_rows(fit_motion.frames_of(rows, info.length)), cam["shift"])
+    speeds = fit_motion.window_values(fit_motion.frames_from_tracks(stable, info.length), RATE)["speed"]
+    assert np.median(speeds) == pytest.approx(0.5, rel=0.05)
+
+
+def test_a_still_camera_stays_still_and_the_scene_keeps_the_sequence_clock(tmp_path, sensor):
+    folder = write_sequence(tmp_path / "seq", moving_people(), size=(W, H))
+    raw, _, _, text = fit_scene.fit_scene(folder, sensor, seeds=(), refine=False)
+    assert raw["world"]["frame_rate"] == RATE and raw["walk"]["model"] == "langevin"
+    assert raw["render"]["camera"] == "still"
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    sc = scenario.load(path)
+    assert sc.world.frame_rate == RATE and sc.walk.model == "langevin" and sc.render.camera == "still"
+    assert sc.walk.speed == pytest.approx(0.5, rel=0.2)
+
+
+def test_people_who_stand_are_fitted_standing(tmp_path):
+    from mtt_sim.sim2real import fit_motion, fit_walkers, motion
+    from mtt_sim.sim.config import WalkConfig
+
+    rows, info = fit_scene.link_sequence(write_sequence(tmp_path / "seq", moving_people(standing=6), size=(W, H)))
+    walk = fit_motion.fit(rows, info)["walk"]
+    assert walk["stop_rate"] / (walk["stop_rate"] + walk["go_rate"]) > 0.6  # six of eight stand, in the long run
+    frames = fit_walkers.simulate(WalkConfig(**walk), RATE, people=60, duration=10.0)
+    assert motion.people(frames, RATE)["standing"] > 0.5

@@ -16,6 +16,12 @@ to what they show (ground truth is never read, so gt/ may be missing or anything
   speed_jitter the relative spread of those speeds;
 - heading: the tracklets' net directions; where most (> half) lie within 45 degrees of their circular mean, that
   mean with heading_jitter 45, else any direction (heading_jitter 180);
+- how the people and the camera move (`mtt_sim.sim2real.fit_motion`): the scene runs at the sequence's frame rate
+  (world.frame_rate), its people walk by the walking model (walk.model = "langevin", its keys fitted to the
+  tracklets with the camera's common motion taken out, then refined by running the scene with its detector and
+  linking its detections as the sequence's were, `fit_scene(refine=True)`), toward exit doors just outside the left
+  and right borders, and its camera is the walking camera model fitted to the common motion where the tracklets show
+  one, else the still camera; the group's cv keys (speed, heading) stay, for walk.model = "off";
 - the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences).
 `statistics` measures the same on any tracklets, so the scene's own detections are checked against the sequence's
 with one function.
@@ -36,6 +42,7 @@ from mtt_sim.env import TrackingEnv
 from mtt_sim.lab.episode import Episode
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario as scn
+from mtt_sim.sim2real import fit_motion
 
 LINKER = "sort:min_hits=3,max_age=3"
 MIN_FRAMES = 5       # tracklets shorter than this are dropped (false positives, fragments)
@@ -157,9 +164,11 @@ def fit(rows: np.ndarray, info) -> dict:
              "motion": "cv", "speed": round(float(np.clip(np.median(speeds), 0.0, 200.0)), 3),
              "speed_jitter": round(float(np.clip(np.std(speeds) / max(np.mean(speeds), 1e-9), 0.0, 1.0)), 3),
              "heading": heading, "heading_jitter": jitter}
+    moved = fit_motion.fit(rows, info)
     return {"name": _camel(info.name), "description": f"Fitted to the detections of {info.name} alone "
-            "(mtt-sim fit-scene).", "world": world, "render": {"width": int(W), "height": int(H)},
-            "env": {"max_steps": int(n)}, "groups": [group]}
+            "(mtt-sim fit-scene).", "world": {**world, **moved["world"]},
+            "render": {"width": int(W), "height": int(H), **moved["render"]}, "walk": moved["walk"],
+            "env": {"max_steps": int(n)}, "groups": [group], "doors": fit_motion.exits(W, H, size[1])}
 
 
 def _heading(net: np.ndarray) -> tuple[float, float]:
@@ -199,7 +208,12 @@ def report(real: dict, scene: dict, name: str) -> str:
     return "\n".join(lines)
 
 
-def fit_scene(folder, sensor=None, seeds=(0, 1)) -> tuple[dict, dict, dict, str]:
+def _scene_tracklets(raw: dict, seed: int) -> np.ndarray:
+    """The tracklets of one run of the scene `raw`, linked as a sequence's are."""
+    return link(TrackingEnv(scn.from_mapping(raw, "fitted scene"), obs_mode="detections"), seed)
+
+
+def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[dict, dict, dict, str]:
     """Fit a scene to a sequence folder's detections: (the scene as a mapping with the sensor merged in, the
     sequence's statistics, the scene's statistics over `seeds`, the TOML text with its header)."""
     rows, info = link_sequence(folder)
@@ -208,11 +222,16 @@ def fit_scene(folder, sensor=None, seeds=(0, 1)) -> tuple[dict, dict, dict, str]
                               "scene to")
     raw = with_sensor(fit(rows, info), sensor)
     scn.from_mapping(raw, f"scene fitted to {folder}")
+    if refine:
+        raw = fit_motion.refine(raw, fit_motion.tracklet_motion(rows, info.length, info.frame_rate), _scene_tracklets,
+                                info.length, info.frame_rate)[0]
     real = statistics(rows, info.length, info.height)
     scene = scene_statistics(raw, seeds) if seeds else {}
     header = [f"mtt-sim fit-scene: a scene fitted to the detections of {Path(folder).name} alone",
               f"({info.length} frames at {info.frame_rate:g} fps; {len(np.unique(rows[:, 1]))} tracklets of at least "
               f"{MIN_FRAMES} frames linked by {LINKER}).",
               "Detector: " + (f"the [sensor] table of {Path(sensor).name}." if sensor is not None else "the default."),
+              f"Motion: walkers by walk.model = \"langevin\" at {info.frame_rate:g} fps; a {raw['render']['camera']} "
+              "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "") + ".",
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]
     return raw, real, scene, scn.to_toml(raw, header)

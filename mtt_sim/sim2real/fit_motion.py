@@ -1,0 +1,315 @@
+"""How a fitted scene moves, from a sequence's tracklets alone (`mtt-sim fit-scene`; issue 38, item 4).
+
+The tracklets (SORT's boxes over the detections) move for two reasons: the people walk, and the camera moves under
+them. The camera's motion is common to every tracklet in a frame; the people's is their own. The fit tells them apart,
+then fits each model to its share:
+
+- the camera's shift a frame: the median displacement of the feet of the tracklets seen in this frame and the last
+  (robust to the few that walk, switch or jump). That median is the camera's only where the camera moves: on a still
+  camera it is the people's own common drift (a crowd walking one way) and box noise. So the shift is kept only where
+  the data show a common motion that no walker makes: the frame-to-frame changes of the tracklets' displacements
+  (their accelerations over EVIDENCE_LAG seconds), split at random into two halves per frame, have medians that
+  agree from frame to frame (split-half correlation at least MOVING_R, and significant: Fisher z at least MOVING_Z;
+  and not below MIN_COMMON px, under which no tracker would see it)
+  where a camera shakes, walks or turns, and do not where only people move (each person's changes are their own and
+  the box noise is each box's own). Where too few tracklets overlap to tell, the camera is taken as still;
+- a moving camera: the walking camera model (`mtt_sim.sim.camera.fit`) fitted to those shifts as a trace (translation
+  only: the roll and the scale change of a frame are below what a few noisy boxes show, so the model's are zero),
+  its spread scaled down to the common motion's share of the per-frame medians (their reliability, from the split
+  halves' correlation: the rest is the boxes' noise);
+  a still one: the still camera model as shipped (a tripod's jitter, fitted to real still cameras, far below box
+  noise);
+- the walkers: the walking model (`walk.model = "langevin"`) fitted to the tracklets with the camera's shift taken
+  out, in body heights and seconds at the sequence's frame rate, as `fit_walkers.fit` fits it to ground truth: the
+  stop and go rates, the desired speed and its spread read off directly (where no stop or no start is seen, the rates
+  from the standing share), the relaxation time and the noise (and the desired speed) chosen by simulating the
+  model's walkers alone. Those are the people as the tracklets show them, box noise included: a detector's boxes
+  jitter and drift by a few percent of a height a frame, which over a one-second constant-velocity guess is as
+  large as real people's own deviation from it on a still camera (fitted so, the walkers came out 1.5-2.5 times too
+  unpredictable on the still MOT15 cameras), and smoothing the tracklets does not take it out (the drift lasts for
+  many frames). So `refine` then runs the scene itself with its detector, links its detections by SORT as the
+  sequence's were, and sets the walkers' desired speed, stop rate and noise so that the scene's tracklets show the
+  sequence's tracklets' median speed, standing share and deviation: like against like, noise, fragments and camera
+  on both sides.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import asdict, replace
+
+import numpy as np
+from scipy.optimize import minimize
+
+from mtt_sim.sim import camera as cam
+from mtt_sim.sim.config import WalkConfig
+from mtt_sim.sim2real import fit_walkers as walkers_fit
+from mtt_sim.sim2real.motion import STANDING, track_rows, window_values
+
+EVIDENCE_LAG = 0.2   # s: the lag of the accelerations whose common part is the camera's
+MOVING_R = 0.2       # split-half correlation of the common accelerations from which the camera moves
+MOVING_Z = 3.0       # ... and its Fisher z (a correlation this far from none by chance is rare)
+MIN_COMMON = 0.2     # px: ... and the common acceleration's size (its root mean square over the frames, both axes)
+SPLITS = 10          # random splits averaged
+MIN_SPLIT_FRAMES = 20  # frames with four tracklets or more that the camera's evidence needs
+MIN_WINDOWS = 100     # two-second stretches of tracklets the walkers' relaxation and noise need
+SIM_PEOPLE, SIM_SECONDS = 60, 15.0  # the walkers simulated for each try of the fit
+REFINE_WINDOWS = 2000  # one-second windows of the scene's tracklets each run of the refinement pools over seeds ...
+MAX_SEEDS = 6         # ... taking at most this many
+LIMITS = {"noise": (0.005, 10.0), "speed": (0.01, 10.0), "stop_rate": (0.01, 100.0)}
+REACH = {"noise": 10.0, "speed": 2.0, "stop_rate": 10.0}  # the refinement moves each at most this far from the fit
+WALK_KEYS = ("model", "speed", "speed_jitter", "relax", "noise", "stand_noise", "stop_rate", "go_rate")
+
+
+def frames_of(rows: np.ndarray, length: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Tracklet rows (frame, id, x, y, w, h; frames from 0) as `length` frames of (ids, boxes)."""
+    rows = rows[np.argsort(rows[:, 0], kind="stable")]
+    cut = np.searchsorted(rows[:, 0], np.arange(length + 1))
+    return [(rows[a:b, 1].astype(np.int64), rows[a:b, 2:6]) for a, b in zip(cut[:-1], cut[1:])]
+
+
+def frames_from_tracks(tracks: dict[int, np.ndarray], length: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per-id (frame, foot x, foot y, height) rows (`motion.track_rows`) back as frames of (ids, boxes), the boxes
+    0.4 heights wide about the foot point."""
+    ids, boxes, at = [], [], []
+    for i, r in tracks.items():
+        ids.append(np.full(len(r), i))
+        at.append(r[:, 0].astype(int))
+        h = r[:, 3]
+        boxes.append(np.c_[r[:, 1] - 0.2 * h, r[:, 2] - h, 0.4 * h, h])
+    if not ids:
+        return [(np.zeros(0, np.int64), np.zeros((0, 4)))] * length
+    ids, boxes, at = np.concatenate(ids), np.concatenate(boxes), np.concatenate(at)
+    order = np.argsort(at, kind="stable")
+    cut = np.searchsorted(at[order], np.arange(length + 1))
+    return [(ids[order[a:b]], boxes[order[a:b]]) for a, b in zip(cut[:-1], cut[1:])]
+
+
+def _per_frame(tracks: dict[int, np.ndarray], length: int, lag: int) -> list[np.ndarray]:
+    """Per frame k, the (m, 2) second differences at `lag` of the foot points of the tracks through k - 2 lag .. k
+    (lag 0: the displacements from k - 1 to k)."""
+    out: list[list] = [[] for _ in range(length)]
+    for r in tracks.values():
+        feet, k = r[:, 1:3], r[:, 0].astype(int)
+        if lag == 0:
+            if len(r) < 2:
+                continue
+            values, at = feet[1:] - feet[:-1], k[1:]
+        else:
+            if len(r) <= 2 * lag:
+                continue
+            values, at = feet[2 * lag:] - 2 * feet[lag:-lag] + feet[:-2 * lag], k[2 * lag:]
+        for j, v in zip(at, values):
+            out[j].append(v)
+    return [np.array(v).reshape(-1, 2) for v in out]
+
+
+def common_shift(tracks: dict[int, np.ndarray], length: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame, the median displacement (px) of the foot points of the tracks seen in it and the frame before, and
+    how many there were; frames with fewer than two take the shift interpolated from their neighbours (0 at the
+    ends), the first frame none."""
+    moves = _per_frame(tracks, length, 0)
+    count = np.array([len(m) for m in moves])
+    shift = np.zeros((length, 2))
+    known = np.flatnonzero(count >= 2)
+    if len(known):
+        med = np.array([np.median(moves[k], axis=0) for k in known])
+        for c in (0, 1):
+            shift[:, c] = np.interp(np.arange(length), known, med[:, c], left=0.0, right=0.0)
+    shift[0] = 0.0
+    return shift, count
+
+
+def camera_evidence(tracks: dict[int, np.ndarray], length: int, frame_rate: float, seed: int = 0) -> dict:
+    """How strongly the tracklets share a common motion that changes: the split-half correlation of the per-frame
+    medians of their accelerations over EVIDENCE_LAG seconds (both axes, averaged over SPLITS random splits), its
+    Fisher z, the frames it rests on and the size of the common acceleration (px, the root mean square of the
+    per-frame medians' length)."""
+    lag = max(1, round(EVIDENCE_LAG * frame_rate))
+    acc = [a for a in _per_frame(tracks, length, lag) if len(a) >= 4]
+    if len(acc) < MIN_SPLIT_FRAMES:
+        return {"r": 0.0, "z": 0.0, "frames": len(acc), "common": 0.0}
+    common = float(np.sqrt(np.mean([np.median(a, axis=0) ** 2 for a in acc]) * 2))
+    rng = np.random.default_rng(seed)
+    rs = []
+    for _ in range(SPLITS):
+        halves = []
+        for a in acc:
+            p = rng.permutation(len(a))
+            h = len(a) // 2
+            halves.append((np.median(a[p[:h]], axis=0), np.median(a[p[h:2 * h]], axis=0)))
+        a, b = np.array(halves).transpose(1, 0, 2)
+        per_axis = [np.corrcoef(a[:, c], b[:, c])[0, 1] for c in (0, 1) if np.std(a[:, c]) > 0 and np.std(b[:, c]) > 0]
+        rs.append(np.mean(per_axis) if per_axis else 0.0)
+    r = float(np.clip(np.mean(rs), -0.999, 0.999))
+    return {"r": r, "z": float(math.atanh(r) * math.sqrt(len(acc) - 3)), "frames": len(acc), "common": common}
+
+
+def stabilise(tracks: dict[int, np.ndarray], shift: np.ndarray) -> dict[int, np.ndarray]:
+    """The tracks with the camera's path (its shifts summed) taken out of their foot points."""
+    path = np.cumsum(shift, axis=0)
+    out = {}
+    for i, r in tracks.items():
+        r = r.copy()
+        r[:, 1:3] -= path[r[:, 0].astype(int)]
+        out[i] = r
+    return out
+
+
+def fit_walkers(frames, frame_rate: float, seed: int = 0) -> WalkConfig:
+    """The walking model whose walkers show the statistics of `frames` at `frame_rate`: `fit_walkers.fit`'s grid and
+    refinement (the same code path, its parameters clipped to the schema's ranges)."""
+    values = window_values(frames, frame_rate)
+    try:
+        direct = walkers_fit.direct([(frames, frame_rate)])
+    except ValueError:  # nobody walks a whole second: the shipped desired speed
+        direct = {}
+    base = replace(WalkConfig(model="langevin"), **direct)
+    if not direct or base.stop_rate <= 0 or base.go_rate <= 0:  # no stop or no start seen
+        base = replace(base, **_rates_from_share(frames, frame_rate))
+    if len(values["deviation"]) < MIN_WINDOWS:  # too short to read the relaxation and the noise: the shipped ones
+        return base
+    target = _statistics(values)
+
+    def with_(relax: float, walk_noise: float, speed: float) -> WalkConfig:
+        return replace(base, relax=float(np.clip(relax, 0.01, 100.0)), noise=float(np.clip(walk_noise, 0.0, 10.0)),
+                       speed=float(np.clip(speed, 0.0, 10.0)))
+
+    def miss(x) -> float:
+        sim = walkers_fit.simulate(with_(*np.exp(x)), frame_rate, SIM_PEOPLE, SIM_SECONDS, seed)
+        got = _statistics(window_values(sim, frame_rate))
+        return float(np.sum(np.log(np.maximum(got, 1e-3) / np.maximum(target, 1e-3)) ** 2))
+
+    start = min(itertools.product(walkers_fit.RELAX, walkers_fit.NOISE), key=lambda rn: miss(np.log([*rn, base.speed])))
+    found = minimize(miss, np.log([*start, base.speed]), method="Nelder-Mead",
+                     options={"xatol": 0.02, "fatol": 1e-4, "maxfev": 120})
+    return with_(*np.exp(found.x))
+
+
+def _rates_from_share(frames, frame_rate: float) -> dict:
+    """Stop and go rates where the tracklets show no stop or no start (people who stand, or walk, for the whole of
+    their short tracklets): a standing spell about twice the median tracklet (it outlasts the tracklets), and the stop
+    rate that keeps the tracklets' standing share of whole seconds."""
+    per_track = walkers_fit.seconds(frames, frame_rate)
+    if not per_track:
+        return {}
+    standing = float(np.mean(np.concatenate(per_track) < STANDING))
+    go = 1.0 / (2.0 * max(1.0, float(np.median([len(s) for s in per_track]))))
+    return {"go_rate": round(go, 4), "stop_rate": round(min(go * standing / max(1 - standing, 0.05), 100.0), 4)}
+
+
+def _statistics(values: dict) -> np.ndarray:
+    """What the walkers are matched on: the median speed, deviation and turn, and the standing share."""
+    med = lambda v: float(np.median(v)) if len(v) else 0.0  # noqa: E731
+    return np.array([med(values["speed"]), med(values["deviation"]), med(values["turning"]),
+                     float(np.mean(values["speed"] < STANDING)) if len(values["speed"]) else 0.0])
+
+
+def fit(rows: np.ndarray, info) -> dict:
+    """The motion of the scene fitted to tracklet rows (frame, id, x, y, w, h) of a sequence with `info` (width,
+    height, frame_rate, length): {"world": {"frame_rate"}, "walk": the walking model's keys, "render": the camera's
+    keys, "camera": what was estimated (the evidence, the per-frame shifts, whether it moves)}."""
+    rate, length = float(info.frame_rate), int(info.length)
+    tracks = track_rows(frames_of(rows, length))
+    shift, count = common_shift(tracks, length)
+    evidence = camera_evidence(tracks, length, rate)
+    moving = evidence["r"] >= MOVING_R and evidence["z"] >= MOVING_Z and evidence["common"] >= MIN_COMMON
+    if moving:
+        tracks = stabilise(tracks, shift)
+        warps = np.repeat(cam.IDENTITY[None], length, axis=0)
+        warps[1:, :, 2] = shift[1:]
+        keys = cam.fit([(warps, info.width, info.height)])
+        # the per-frame median carries the boxes' noise too: the model's spread is the common motion's share of it,
+        # the full median's reliability from the split halves' correlation (Spearman-Brown)
+        share = math.sqrt(min(1.0, 2 * evidence["r"] / (1 + evidence["r"])))
+        keys["camera_step"] = [round(v * share, 6) for v in keys["camera_step"]]
+        render = {"camera": "walking", **keys, "camera_turn": 0.0, "camera_zoom": 0.0}
+    else:
+        shift = np.zeros_like(shift)
+        render = {"camera": "still"}
+    walkers = fit_walkers(frames_from_tracks(tracks, length), rate)
+    walk = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in asdict(walkers).items() if k in WALK_KEYS}
+    return {"world": {"frame_rate": rate}, "walk": walk, "render": render,
+            "camera": {**evidence, "moving": bool(moving), "shift": shift, "overlaps": count}}
+
+
+def tracklet_motion(rows: np.ndarray, length: int, frame_rate: float) -> np.ndarray:
+    """The median speed, the median one-second deviation (heights) and the standing share of tracklet rows, as
+    `motion.people` measures them (nan where there is no window)."""
+    return _measured(window_values(frames_of(rows, length), frame_rate))
+
+
+def _measured(values: dict) -> np.ndarray:
+    """The median speed and deviation and the standing share of `motion.window_values`' values."""
+    med = lambda v: float(np.median(v)) if len(v) else float("nan")  # noqa: E731
+    speed = values["speed"]
+    return np.array([med(speed), med(values["deviation"]),
+                     float(np.mean(speed < STANDING)) if len(speed) else float("nan")])
+
+
+def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: float,
+           seeds=(100, 101)) -> tuple[dict, list]:
+    """The scene `raw` (with its detector) with its walkers' desired speed, noise and stop rate set so that the
+    scene's own tracklets (`tracklets(raw, seed)`: its detections linked as the sequence's were, over `seeds`) show the
+    sequence's tracklets' median speed, median one-second deviation and standing share, `target` (`tracklet_motion`;
+    the scene's pooled over `seeds` and more, up to MAX_SEEDS, until REFINE_WINDOWS windows):
+    both seen through a detector and SORT, so that box noise, fragments and the camera count alike on both sides.
+    Two runs. The first, as fitted directly, scales the desired speed and the stop rate by the sequence's over the
+    scene's (a walker's measured speed and standing follow them nearly in proportion). The second, with those and a
+    tenth of the noise, measures the deviation that the detector, SORT and the camera make by themselves (the floor):
+    the deviation of the tracklets is taken as the floor and the walkers' own adding in squares, the walkers' growing
+    with their noise, and the noise is the one whose walkers bring the floor up to the sequence's. Where the floor is
+    already above the sequence's (the scene's detector is noisier than the sequence's was: the people are steadier
+    than the boxes show, by how much the data cannot say) or the two runs show no response, the first run's noise is
+    scaled by the sequence's deviation over the scene's. Returns the scene and the two runs' keys and
+    measurements."""
+    walk = dict(raw["walk"])
+    history: list[tuple[dict, np.ndarray]] = []
+    if not np.all(np.isfinite(target)):
+        return raw, history
+
+    def run(w: dict) -> np.ndarray:  # pooled over seeds, as many as give REFINE_WINDOWS windows (MAX_SEEDS at most)
+        values = []
+        for seed in range(seeds[0], seeds[0] + MAX_SEEDS):
+            values.append(window_values(frames_of(tracklets({**raw, "walk": w}, seed), length), frame_rate))
+            if seed - seeds[0] + 1 >= len(seeds) and sum(len(v["speed"]) for v in values) >= REFINE_WINDOWS:
+                break
+        got = _measured({k: np.concatenate([v[k] for v in values]) for k in ("speed", "deviation")})
+        history.append((dict(w), got))
+        return got
+
+    first = run(walk)
+    if not np.all(np.isfinite(first)):
+        return raw, history
+    low = {**walk, "speed": _scaled(walk["speed"], target[0] / max(first[0], 1e-6), "speed"),
+           "stop_rate": _scaled(max(walk["stop_rate"], 0.01), (target[2] + 0.02) / (first[2] + 0.02), "stop_rate"),
+           "noise": round(max(walk["noise"] / 10, LIMITS["noise"][0]), 4)}
+    second = run(low)
+    if not np.all(np.isfinite(second)):
+        return raw, history
+    slope = (first[1] ** 2 - second[1] ** 2) / max(walk["noise"] ** 2 - low["noise"] ** 2, 1e-12)
+    floor = second[1] ** 2 - slope * low["noise"] ** 2
+    if slope > 0 and target[1] ** 2 > floor:
+        noise = math.sqrt((target[1] ** 2 - floor) / slope)
+    else:  # the floor is at or above the sequence's, or no response was seen: the noise deflated in proportion
+        noise = walk["noise"] * target[1] / max(first[1], 1e-6)
+    final = {**low, "noise": round(float(np.clip(noise, low["noise"], walk["noise"] * REACH["noise"])), 4)}
+    return {**raw, "walk": final}, history
+
+
+def _scaled(value: float, factor: float, key: str) -> float:
+    """`value` times `factor`, the factor within REACH, the result within the schema's LIMITS."""
+    factor = float(np.clip(factor, 1 / REACH[key], REACH[key]))
+    return round(float(np.clip(value * factor, *LIMITS[key])), 4)
+
+
+def exits(width: float, height: float, margin: float) -> list[dict]:
+    """Exit doors just outside the world's left and right borders, four along each, so that walkers, who head for a
+    random exit, cross the scene and leave it, as the world's own goal (the far side) has them cross it (without
+    exits that goal is a point inside the world, where they would stay)."""
+    doors = []
+    for f in (1 / 8, 3 / 8, 5 / 8, 7 / 8):
+        doors += [[-2 * margin, f * height - margin / 2, margin, margin],
+                  [width + margin, f * height - margin / 2, margin, margin]]
+    return [{"rect": [round(float(v), 1) for v in d], "role": "exit"} for d in doors]
