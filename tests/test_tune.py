@@ -269,6 +269,8 @@ def test_a_trial_left_running_by_a_dead_process_is_rerun_and_another_machines_le
 def test_ctrl_c_is_held_while_the_study_is_written_and_stops_the_episodes_at_once():
     interrupts = tune._Interrupts()
     previous = signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))  # as the CLI's
+    # Python's own Ctrl-C handler, which a process started in the background of a script (SIGINT ignored) lacks
+    ignored = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         with interrupts.held():
             for sig in (signal.SIGINT, signal.SIGTERM):
@@ -284,6 +286,7 @@ def test_ctrl_c_is_held_while_the_study_is_written_and_stops_the_episodes_at_onc
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     finally:
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, ignored)
 
 
 def test_ctrl_c_on_the_command_reports_the_best_so_far_writes_out_and_exits_130(tmp_path, capsys, monkeypatch):
