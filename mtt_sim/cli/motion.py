@@ -73,15 +73,17 @@ def run(args) -> int:
     if fit and not real and not args.trace:
         raise UsageError("--fit", "fits the walking model to real ground truth and the camera to traces: give "
                                   "sequence folders (with gt/gt.txt) among the sources, or --trace files")
-    still = [_is_still(t, args.trace_size) for t in args.trace] if fit else []
-    if len(set(still)) > 1:
+    traces = {t: motion.read_warps(t) for t in args.trace}
+    trace_cameras = {t: motion.camera(w, *args.trace_size) for t, w in traces.items()}
+    still = [c["translation median (width)"] < STILL for c in trace_cameras.values()]
+    if fit and len(set(still)) > 1:
         raise UsageError("--fit", "the traces mix still cameras (" + ", ".join(t for t, s in zip(args.trace, still) if s)
                          + ") and moving ones: fit each kind apart")
     if dry_run(args, estimate("motion", [(len(args.sources), "episodes")], args.sources, overrides, steps=args.steps)
                if args.sources else f"motion: {len(args.trace)} traces read"):
         return 0
 
-    people, windows, cameras = {}, {}, {}
+    people, windows, cameras, truths = {}, {}, {}, []
     for source in args.sources:
         warps = []
         frames, frame_rate, size = motion.scored_frames(source, overrides, args.seed, args.steps, warps)
@@ -90,11 +92,13 @@ def run(args) -> int:
         windows[name] = motion.window_values(frames, frame_rate)
         if warps:  # a simulated scene's own camera
             cameras[name] = motion.camera(warps, *size)
-    cameras.update({Path(t).stem: motion.camera(motion.read_warps(t), *args.trace_size) for t in args.trace})
+        if source in real:
+            truths.append((frames, frame_rate))
+    cameras.update({Path(t).stem: c for t, c in trace_cameras.items()})
     if plot:
         motion.plot(windows, plot)
     if fit:
-        tables = _fitted(real, args.trace, args.trace_size, overrides, any(still))
+        tables = _fitted(truths, [(w, *args.trace_size) for w in traces.values()], any(still))
         from mtt_sim.sim import scenario
 
         fit.write_text(scenario.to_toml(tables, ["fitted by mtt-sim motion --fit to " + ", ".join(
@@ -117,22 +121,15 @@ def run(args) -> int:
 STILL = 3e-4  # a trace whose image centre moves a median share of the width below this is a still camera's
 
 
-def _is_still(trace: str, size: tuple[int, int]) -> bool:
-    from mtt_sim.sim2real import motion
-
-    return motion.camera(motion.read_warps(trace), *size)["translation median (width)"] < STILL
-
-
-def _fitted(sequences: list[str], traces: list[str], size: tuple[int, int], overrides: dict, still: bool) -> dict:
-    """The [walk] table fitted to the sequences' ground truth and the [render] camera keys fitted to the traces:
-    the still camera's where they are `still`, else the walking camera's."""
+def _fitted(truths: list, traces: list, still: bool) -> dict:
+    """The [walk] table fitted to real ground truth, (frames, frame rate) each, and the [render] camera keys fitted
+    to traces, (warps, width, height) each: the still camera's where they are `still`, else the walking camera's."""
     from mtt_sim.sim import camera
-    from mtt_sim.sim2real import fit_walkers, motion
+    from mtt_sim.sim2real import fit_walkers
 
     tables = {}
-    if sequences:
-        tables["walk"] = dataclasses.asdict(fit_walkers.fit(motion.scored_frames(s, overrides)[:2] for s in sequences))
+    if truths:
+        tables["walk"] = dataclasses.asdict(fit_walkers.fit(truths))
     if traces:
-        warps = [(motion.read_warps(t), *size) for t in traces]
-        tables["render"] = {"camera": "still" if still else "walking", **camera.fit(warps, still=still)}
+        tables["render"] = {"camera": "still" if still else "walking", **camera.fit(traces, still=still)}
     return tables
