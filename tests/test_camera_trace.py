@@ -8,7 +8,7 @@ import pytest
 from mtt_sim import ConfigError
 from mtt_sim.env import TrackingEnv
 from mtt_sim.sim import camera as cam
-from mtt_sim.sim2real.motion import read_warps
+from mtt_sim.sim.camera import read_warps
 
 NO_TRACKS = {"ids": np.zeros(0, np.int64), "boxes": np.zeros((0, 4), np.float32)}
 

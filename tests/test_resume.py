@@ -50,7 +50,6 @@ DONE = []  # the pieces of work the last run did
 
 def run(argv, folder, monkeypatch, capsys, stop_after=None) -> tuple[int, str, str]:
     """The command in `folder`, interrupted (as by Ctrl-C) right after its journal's `stop_after`-th new piece."""
-    monkeypatch.chdir(folder)
     put = Journal.put
     DONE.clear()
 
@@ -59,9 +58,10 @@ def run(argv, folder, monkeypatch, capsys, stop_after=None) -> tuple[int, str, s
         DONE.append(key)
         if len(DONE) == stop_after:
             raise KeyboardInterrupt
-    monkeypatch.setattr(Journal, "put", counting)
-    code = cli.main(argv)
-    monkeypatch.undo()
+    with monkeypatch.context() as patch:
+        patch.chdir(folder)
+        patch.setattr(Journal, "put", counting)
+        code = cli.main(argv)
     return code, *capsys.readouterr()
 
 

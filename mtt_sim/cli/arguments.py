@@ -401,15 +401,12 @@ def announce(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
-def dry_run(args, line: str, announce: bool = False) -> bool:
-    """The estimate `line`: with --dry-run printed (stdout) and True, the command stops there; otherwise printed on
-    stderr where `announce` (a long run says what it is about to do; stdout and --json stay clean) and False."""
+def dry_run(args, line: str) -> bool:
+    """With --dry-run, the estimate `line` printed (stdout) and True: the command stops there; else False (a long run
+    then says it with `announce` once its last check has passed)."""
     if getattr(args, "dry_run", False):
         print(line)
-        return True
-    if announce:
-        print(line, file=sys.stderr, flush=True)
-    return False
+    return bool(getattr(args, "dry_run", False))
 
 
 # ------------------------------------------------------------------ what the commands print

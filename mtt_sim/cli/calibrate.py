@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import shlex
 
-from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, distinct_folders, dry_run, estimate,
-                                   integer, output_file, replaced)
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, announce, calibration_folder, distinct_folders, dry_run,
+                                   estimate, integer, output_file, replaced)
 
 
 def add(subparsers) -> None:
@@ -24,9 +24,11 @@ def add(subparsers) -> None:
 def run(args) -> int:
     distinct_folders(args.folders)
     out = output_file(args.out, args.force, "--out", (".toml",))
-    if dry_run(args, estimate("calibrate", [(len(args.folders), "sequences"), (args.seeds, "seeds")], args.folders,
-                              unit="twin runs"), announce=True):
+    work = estimate("calibrate", [(len(args.folders), "sequences"), (args.seeds, "seeds")], args.folders,
+                    unit="twin runs")
+    if dry_run(args, work):
         return 0
+    announce(work)
     from mtt_sim.sim2real import calibrate
 
     fitted = calibrate.calibrate(args.folders, seeds=args.seeds, progress=True)

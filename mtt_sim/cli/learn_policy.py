@@ -5,14 +5,12 @@ from __future__ import annotations
 import argparse
 import math
 import shutil
-import sys
 from pathlib import Path
 
 from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (
     CONFIG_HELP,
     FORCE_HELP,
-    INTERRUPTED,
     UsageError,
     add_dry_run,
     add_overrides,
@@ -102,10 +100,7 @@ def run(args) -> int:
                                 args.workers, metrics, overrides, args.frames, progress=True, base=args.base,
                                 work=work, journal=journal)
     except KeyboardInterrupt:
-        journal.close()
-        print(f"mtt-sim learn-policy: interrupted; the episodes replayed are kept in {journal.path} (and {work}): "
-              "the same command with --resume goes on from there", file=sys.stderr)
-        return INTERRUPTED
+        return resuming.stopped("learn-policy", journal, f"the episodes replayed (and {work})")
     journal.finish()
     shutil.rmtree(work)
     save_policy(out, learning.weights, trained_on=",".join(args.on), seeds=str(list(args.seeds)), base=args.base,

@@ -11,10 +11,12 @@ from pathlib import Path
 from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, add_dry_run, add_overrides, dry_run, episode_overrides,
                                    estimate, integer, loaded, output_file, replaced, scenario_key)
 
+STILL = 3e-4  # a trace whose image centre moves a median share of the width below this is a still camera's
+
 
 def trace_file(text: str) -> str:
     """A camera trace in BoT-SORT's GMC format, read whole (a bad row is named)."""
-    from mtt_sim.sim2real.motion import read_warps
+    from mtt_sim.sim.camera import read_warps
 
     try:
         read_warps(text)
@@ -61,6 +63,7 @@ def run(args) -> int:
         raise UsageError("SOURCE", "give sequence folders or scenarios, or --trace files, or both")
     overrides = episode_overrides(args)
     from mtt_sim.real.layout import is_sequence
+    from mtt_sim.sim.camera import read_warps
     from mtt_sim.sim2real import motion
 
     for source in args.sources:
@@ -73,7 +76,7 @@ def run(args) -> int:
     if fit and not real and not args.trace:
         raise UsageError("--fit", "fits the walking model to real ground truth and the camera to traces: give "
                                   "sequence folders (with gt/gt.txt) among the sources, or --trace files")
-    traces = {t: motion.read_warps(t) for t in args.trace}
+    traces = {t: read_warps(t) for t in args.trace}
     trace_cameras = {t: motion.camera(w, *args.trace_size) for t, w in traces.items()}
     still = [c["translation median (width)"] < STILL for c in trace_cameras.values()]
     if fit and len(set(still)) > 1:
@@ -117,8 +120,6 @@ def run(args) -> int:
               f"them as its own tables, or as --config {' '.join(keys)}")
     return 0
 
-
-STILL = 3e-4  # a trace whose image centre moves a median share of the width below this is a still camera's
 
 
 def _fitted(truths: list, traces: list, still: bool) -> dict:

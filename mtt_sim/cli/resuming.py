@@ -4,9 +4,10 @@ takes what the journal holds and runs only the rest, ending with the outputs an 
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
-from mtt_sim.cli.arguments import UsageError
+from mtt_sim.cli.arguments import INTERRUPTED, UsageError
 
 
 def add(parser, output: str) -> None:
@@ -46,7 +47,13 @@ def journal(out, definition: dict, resume: bool, unit: str):
     except JournalMismatch as err:
         raise UsageError("--resume", str(err)) from None
     if opened.resumed:
-        import sys
-
         print(f"resuming: {opened.resumed} finished {unit} kept from {opened.path}", file=sys.stderr)
     return opened
+
+
+def stopped(command: str, journal, kept: str) -> int:
+    """An interrupted run's end: its journal closed, one line on what `kept` holds and how to go on; status 130."""
+    journal.close()
+    print(f"mtt-sim {command}: interrupted; {kept} are kept in {journal.path}: the same command with --resume goes on "
+          "from there", file=sys.stderr)
+    return INTERRUPTED

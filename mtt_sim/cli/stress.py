@@ -8,7 +8,7 @@ import shlex
 import sys
 
 from mtt_sim.cli import resuming
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, UsageError, add_dry_run, add_overrides,
                                    announce, dry_run, episode_overrides, estimate, integer, loaded, output_folder, parse_seeds,
                                    replaced, require, scenario_key, tracker_spec)
 
@@ -118,10 +118,7 @@ def run(args) -> int:
     except KeyboardInterrupt:
         if not journal:
             raise
-        journal.close()
-        print(f"mtt-sim stress: interrupted; the scenes evaluated are kept in {journal.path}: the same command with "
-              "--resume goes on from there", file=sys.stderr)
-        return INTERRUPTED
+        return resuming.stopped("stress", journal, "the scenes evaluated")
     if not found.scenes:
         raise ValueError("every scene failed: " + "; ".join(sorted({f["error"] for f in found.failed})))
     if out:

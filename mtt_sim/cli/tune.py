@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides,
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, INTERRUPTED, UsageError, add_dry_run, add_overrides, announce,
                                    dry_run, episode_overrides, estimate, integer, loaded, output_file, parse_seeds,
                                    replaced, require, scenario_keys, tracker_spec)
 
@@ -70,8 +70,10 @@ def run(args) -> int:
     elif args.address:
         raise UsageError("--address", f"{args.address!r}: a Ray cluster's address goes with --backend ray")
     trials = [(args.trials, "trials"), (len(args.on), "sources"), (len(args.seeds), "seeds")]
-    if dry_run(args, estimate("tune", trials, args.on, overrides), announce=True):
+    work = estimate("tune", trials, args.on, overrides)
+    if dry_run(args, work):
         return 0
+    announce(work)
     from mtt_sim.lab import tune
 
     try:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, calibration_folder, distinct_folders, dry_run, estimate,
-                                   integer, output_file, replaced, tracker_specs)
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, announce, calibration_folder, distinct_folders, dry_run,
+                                   estimate, integer, output_file, replaced, tracker_specs)
 
 
 def add(subparsers) -> None:
@@ -30,8 +30,10 @@ def run(args) -> int:
     twins = [t for t in validate.TWINS if len(args.folders) > 1 or not t.leave_one_out]
     runs = (len(args.folders), "sequences"), (len(specs), "trackers"), (1 + len(twins) * args.seeds, "runs (1 real, "
                                                                          f"{len(twins)} twins x {args.seeds} seeds)")
-    if dry_run(args, estimate("validate", runs, args.folders), announce=True):
+    work = estimate("validate", runs, args.folders)
+    if dry_run(args, work):
         return 0
+    announce(work)
     result = validate.validate(args.folders, specs, seeds=args.seeds, workers=args.workers,
                                progress=True)
     text = validate.markdown(result)

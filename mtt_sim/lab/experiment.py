@@ -154,18 +154,19 @@ def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, 
     `processes` (from `episode_pool`) runs them in workers already started, instead of `workers` new ones. Each
     finished record goes into `journal`, keyed by its task, and the tasks it already holds are taken from it."""
     records: list = [None] * len(tasks)
-    kept = [i for i, task in enumerate(tasks) if journal is not None and repr(task) in journal]
-    missing = sorted(set(range(len(tasks))) - set(kept))
+    keys = [repr(task) for task in tasks]
+    kept = [i for i, key in enumerate(keys) if journal is not None and key in journal]
+    missing = [i for i, key in enumerate(keys) if journal is None or key not in journal]
     with tqdm(total=len(tasks), initial=len(kept), unit="episode", disable=not progress, dynamic_ncols=True) as bar:
         for i in kept:
-            records[i] = journal.get(repr(tasks[i]))
+            records[i] = journal.get(keys[i])
             if on_record:
                 on_record(records[i])
         for j, record in _finished([tasks[i] for i in missing], workers, backend, address, processes):
             i = missing[j]
             records[i] = record
             if journal is not None:
-                journal.put(repr(tasks[i]), record)
+                journal.put(keys[i], record)
             if on_record:
                 on_record(record)
             bar.set_postfix_str(f"{record['tracker']} on {record['scenario']} seed {record['seed']}"

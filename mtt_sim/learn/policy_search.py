@@ -11,6 +11,7 @@ which costs only the tracker and the scoring. The search starts from SORT's own 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import tempfile
@@ -87,8 +88,8 @@ def learn_policy(sources: Sequence[str], seeds: Sequence[int] = (0,), generation
         raise ValueError(f"population={population!r}: allowed: 4 or more (CMA-ES's weights need several parents)")
     if not sigma > 0 or not math.isfinite(sigma):
         raise ValueError(f"sigma={sigma!r}: allowed: a finite number > 0")
-    with tempfile.TemporaryDirectory(prefix="mtt-sim-learn-") as tmp:
-        folder = Path(work or tmp).resolve()
+    with contextlib.nullcontext(work) if work else tempfile.TemporaryDirectory(prefix="mtt-sim-learn-") as where:
+        folder = Path(where).resolve()
         folder.mkdir(parents=True, exist_ok=True)
         episodes = replays(sources, seeds, folder, config, steps, journal, progress)
         start = SORT_RULES.ravel()

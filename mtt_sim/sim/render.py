@@ -14,7 +14,7 @@ from functools import cached_property
 import cv2
 import numpy as np
 
-from mtt_sim.sim.camera import Camera, WarpCamera, compose, invert, make_camera, shift, warp_boxes  # noqa: F401
+from mtt_sim.sim.camera import WarpCamera, compose, invert, make_camera, shift, warp_boxes
 from mtt_sim.sim.config import TEXTURES, Scenario
 from mtt_sim.sim.world import World
 
@@ -145,7 +145,8 @@ class Renderer:
         m = self.camera.margin
         ww, wh = (int(math.ceil(v)) for v in self.sc.world_size)
         corners = np.array([[0, 0], [w, 0], [0, h], [w, h]], float)
-        seen = corners @ invert(pose)[:, :2].T + invert(pose)[:, 2]
+        back = invert(pose)
+        seen = corners @ back[:, :2].T + back[:, 2]
         x0, y0 = np.clip(np.floor(seen.min(axis=0)).astype(int) - 1, -m, (ww + m, wh + m))
         x1, y1 = np.clip(np.ceil(seen.max(axis=0)).astype(int) + 2, -m, (ww + m, wh + m))
         world_boxes = world.boxes()

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mtt_sim.sim.camera import read_warps
 from mtt_sim.sim.config import ConfigError, Scenario
 from mtt_sim.sim.render import Renderer
 from mtt_sim.sim.sensor import Detections, Sensor, make_sensor
@@ -101,8 +102,6 @@ def _trace(sc: Scenario) -> np.ndarray | None:
         return None
     if not r.trace:
         raise ConfigError("render.trace: render.camera = 'trace' needs a camera-motion file (BoT-SORT's GMC format)")
-    from mtt_sim.sim.camera import read_warps
-
     try:
         warps = read_warps(r.trace)
     except ValueError as err:

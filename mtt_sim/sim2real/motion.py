@@ -20,8 +20,6 @@ from typing import Iterable
 
 import numpy as np
 
-from mtt_sim.sim.camera import read_warps  # noqa: F401  (traces are read where the simulator replays them)
-
 STANDING = 0.1  # heights per second: slower than this, a person stands
 
 
