@@ -55,6 +55,9 @@ def test_estimates_equal_the_known_answers(tmp_path):
     assert g["count"] == 5 and g["birth_rate"] == 0.0                        # every person in every frame
     assert g["speed"] == pytest.approx(NEAR_SPEED, abs=1e-3)                # exact boxes: the SORT boxes are them
     assert (g["heading"], g["heading_jitter"]) == (pytest.approx(0.0, abs=0.1), 45.0)
+    assert (sides(raw, "entry"), sides(raw, "exit")) == (("left",), ("right",))  # all walk right
+    feet = [d["rect"][1] + d["rect"][3] / 2 for d in raw["doors"]]            # doors in the band of the feet
+    assert min(feet) >= g["region"][1] * H - 1 and max(feet) <= g["region"][3] * H + 1
     assert g["region"][1] == pytest.approx(FEET[0] / H, abs=0.02) and g["region"][3] == pytest.approx(FEET[-1] / H,
                                                                                                        abs=0.02)
     st = fit_scene.statistics(rows, info.length, H)
@@ -66,9 +69,18 @@ def test_a_late_person_is_a_birth_and_opposite_walkers_go_any_way(tmp_path):
     # 5 + (20 - 3) / 30 people per frame (it is detected in frames 11..30)
     raw, rows, info = fitted(write_sequence(tmp_path / "seq", walkers((1, -1, 1, -1, -1), late=11), size=(W, H)))
     g = raw["groups"][0]
-    assert g["birth_rate"] == pytest.approx(1 / (FRAMES - 1), abs=1e-4)
+    entries = [d for d in raw["doors"] if d["role"] == "entry"]
+    assert g["birth_rate"] == 0.0 and sum(d["birth_rate"] for d in entries) == pytest.approx(1 / (FRAMES - 1),
+                                                                                              abs=1e-3)
     assert fit_scene.statistics(rows, FRAMES, H)["people"] == pytest.approx(5 + 17 / 30)
     assert (g["heading"], g["heading_jitter"]) == (0.0, 180.0)
+    # walking both ways: they come and go on both sides
+    assert {sides(raw, "entry"), sides(raw, "exit")} == {("left", "right")}
+
+
+def sides(raw: dict, role: str) -> tuple[str, ...]:
+    """The borders (left, right) of a fitted scene's doors of `role`."""
+    return tuple(sorted({"left" if d["rect"][0] < 0 else "right" for d in raw["doors"] if d["role"] == role}))
 
 
 def test_heights_that_do_not_grow_downward_make_a_topdown_world(tmp_path):

@@ -30,6 +30,8 @@ class Walkers:
         self.cfg, self.dt = config, 1.0 / frame_rate
         self.p_stop = 1.0 - math.exp(-config.stop_rate * self.dt)
         self.p_go = 1.0 - math.exp(-config.go_rate * self.dt)
+        self.standing_share = config.stop_rate / max(config.stop_rate + config.go_rate, 1e-9)  # the two-state
+        # process's stationary share: the chance that a person seen at an arbitrary moment stands
 
     def desired_speed(self, rng: np.random.Generator) -> float:
         """A new person's desired speed, heights per second (log-normal about `speed`, `speed_jitter` its spread)."""

@@ -155,7 +155,7 @@ class World:
             corners = np.array(g.region) * np.tile(self.extent, 2)
             for _ in range(g.count):
                 pos = self._free_spot(g, (corners[:2], corners[2:]), grid)
-                size = self._spawn(gi, pos, self._initial_velocity(g))
+                size = self._spawn(gi, pos, self._initial_velocity(g), in_view=True)
                 grid.add(g.layer, pos, 0.5 * size.max())
         self._flush()
 
@@ -178,21 +178,26 @@ class World:
             return self.rng.normal(0, g.speed, 2)
         return speed * np.array([math.cos(heading), math.sin(heading)])
 
-    def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None) -> np.ndarray:
+    def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None,
+               in_view: bool = False) -> np.ndarray:
         """Add one target of group `gi`: a pymunk body now, a row of every state array at the next `_flush`.
-        Returns its size."""
+        Returns its size. A walker placed `in_view` at reset stands with the walking model's stationary share (the
+        scene opens on people already there, some of them waiting); one entering walks."""
         g = self.sc.groups[gi]
         size = np.array(g.size) * np.exp(g.size_jitter * self.rng.normal(size=2))
         hue = self._hue0 + 0.618034 * self.next_id
         color = (1 - g.similarity) * hue_colors(np.array([hue]))[0] + g.similarity * np.array(g.color)
         phase, goal = self.rng.uniform(0, 2 * math.pi), self._pick_goal(pos)
-        desired = 0.0
+        desired, stopped = 0.0, False
         if self._walk is not None and carrier is None:  # a walker sets off toward its goal at its own speed
             desired = self._walk.desired_speed(self.rng)
             vel = (goal - pos) / max(np.hypot(*(goal - pos)), 1e-9) * desired * size[1] * self._walk.dt
+            stopped = in_view and bool(self.rng.random() < self._walk.standing_share)
+            if stopped:
+                vel = np.zeros(2)
         self._pending.append(dict(
             ids=self.next_id, group=gi, pos=pos, vel=vel, size=size, color=np.round(color),
-            cruise=float(np.hypot(*vel)) or g.speed, phase=phase, goal=goal, stopped=False, born=self.t,
+            cruise=float(np.hypot(*vel)) or g.speed, phase=phase, goal=goal, stopped=stopped, born=self.t,
             carrier_id=0 if carrier is None else int(self.ids[carrier]),
             carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier],
             carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel, desired=desired))

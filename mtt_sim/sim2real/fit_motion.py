@@ -28,9 +28,11 @@ then fits each model to its share:
   large as real people's own deviation from it on a still camera (fitted so, the walkers came out 1.5-2.5 times too
   unpredictable on the still MOT15 cameras), and smoothing the tracklets does not take it out (the drift lasts for
   many frames). So `refine` then runs the scene itself with its detector, links its detections by SORT as the
-  sequence's were, and sets the walkers' desired speed, stop rate and noise so that the scene's tracklets show the
-  sequence's tracklets' median speed, standing share and deviation: like against like, noise, fragments and camera
-  on both sides.
+  sequence's were, and sets the detector's box noise, the walkers' stop rate and noise so that the scene's tracklets
+  show the sequence's tracklets' jitter, standing share and deviation: like against like, noise, fragments and
+  camera on both sides;
+- where they come and go (`doors`): entries and exits at the left and right borders in the band of the feet, on the
+  sides the tracklets come from and go to.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from mtt_sim.sim import camera as cam
+from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.config import WalkConfig
 from mtt_sim.sim2real import fit_walkers as walkers_fit
 from mtt_sim.sim2real.motion import STANDING, track_rows, window_values
@@ -57,8 +60,11 @@ MIN_WINDOWS = 100     # two-second stretches of tracklets the walkers' relaxatio
 SIM_PEOPLE, SIM_SECONDS = 60, 15.0  # the walkers simulated for each try of the fit
 REFINE_WINDOWS = 2000  # one-second windows of the scene's tracklets each run of the refinement pools over seeds ...
 MAX_SEEDS = 6         # ... taking at most this many
-LIMITS = {"noise": (0.005, 10.0), "speed": (0.01, 10.0), "stop_rate": (0.01, 100.0)}
-REACH = {"noise": 10.0, "speed": 2.0, "stop_rate": 10.0}  # the refinement moves each at most this far from the fit
+LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0)}
+REACH = {"noise": 10.0, "stop_rate": 10.0}  # the refinement moves each at most this far from the fit
+NOISE_KEYS = ("box_noise", "box_size_noise", "box_drift", "box_size_drift")  # the detector's, scaled to the jitter
+NOISE_REACH = 4.0     # ... at most this far either way
+SIDEWAYS = math.cos(math.radians(45))  # a heading whose cosine is beyond this walks across (left or right)
 WALK_KEYS = ("model", "speed", "speed_jitter", "relax", "noise", "stand_noise", "stop_rate", "go_rate")
 
 
@@ -235,57 +241,75 @@ def fit(rows: np.ndarray, info) -> dict:
 
 
 def tracklet_motion(rows: np.ndarray, length: int, frame_rate: float) -> np.ndarray:
-    """The median speed, the median one-second deviation (heights) and the standing share of tracklet rows, as
-    `motion.people` measures them (nan where there is no window)."""
-    return _measured(window_values(frames_of(rows, length), frame_rate))
+    """The median speed, the median one-second deviation (heights), the standing share (as `motion.people` measures
+    them) and the median jitter (`jitters`) of tracklet rows (nan where there is none)."""
+    frames = frames_of(rows, length)
+    return _measured(window_values(frames, frame_rate), jitters(frames))
 
 
-def _measured(values: dict) -> np.ndarray:
-    """The median speed and deviation and the standing share of `motion.window_values`' values."""
+def jitters(frames) -> np.ndarray:
+    """Each tracked foot point's second difference over consecutive frames, in heights: the boxes' frame-to-frame
+    jitter, which is the detector's far more than the people's (a walker's change of velocity in one frame is small)."""
+    out = [np.hypot(*(r[2:, 1:3] - 2 * r[1:-1, 1:3] + r[:-2, 1:3]).T) / r[1:-1, 3]
+           for r in track_rows(frames).values() if len(r) >= 3]
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def _measured(values: dict, jitter: np.ndarray) -> np.ndarray:
+    """The median speed and deviation and the standing share of `motion.window_values`' values, and the median
+    `jitter`."""
     med = lambda v: float(np.median(v)) if len(v) else float("nan")  # noqa: E731
     speed = values["speed"]
     return np.array([med(speed), med(values["deviation"]),
-                     float(np.mean(speed < STANDING)) if len(speed) else float("nan")])
+                     float(np.mean(speed < STANDING)) if len(speed) else float("nan"), med(jitter)])
 
 
 def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: float,
            seeds=(100, 101)) -> tuple[dict, list]:
-    """The scene `raw` (with its detector) with its walkers' desired speed, noise and stop rate set so that the
-    scene's own tracklets (`tracklets(raw, seed)`: its detections linked as the sequence's were, over `seeds`) show the
-    sequence's tracklets' median speed, median one-second deviation and standing share, `target` (`tracklet_motion`;
-    the scene's pooled over `seeds` and more, up to MAX_SEEDS, until REFINE_WINDOWS windows):
-    both seen through a detector and SORT, so that box noise, fragments and the camera count alike on both sides.
-    Two runs. The first, as fitted directly, scales the desired speed and the stop rate by the sequence's over the
-    scene's (a walker's measured speed and standing follow them nearly in proportion). The second, with those and a
-    tenth of the noise, measures the deviation that the detector, SORT and the camera make by themselves (the floor):
-    the deviation of the tracklets is taken as the floor and the walkers' own adding in squares, the walkers' growing
-    with their noise, and the noise is the one whose walkers bring the floor up to the sequence's. Where the floor is
-    already above the sequence's (the scene's detector is noisier than the sequence's was: the people are steadier
-    than the boxes show, by how much the data cannot say) or the two runs show no response, the first run's noise is
-    scaled by the sequence's deviation over the scene's. Returns the scene and the two runs' keys and
+    """The scene `raw` (with its detector) with its detector's box noise, its walkers' noise and stop rate set so
+    that the scene's own tracklets (`tracklets(raw, seed)`: its detections linked as the sequence's were, pooled over
+    `seeds` and more, up to MAX_SEEDS, until REFINE_WINDOWS windows) show the sequence's tracklets' jitter, median
+    one-second deviation and standing share (`target`, from `tracklet_motion`): both seen through a detector and SORT,
+    so that box noise, fragments and the camera count alike on both sides. Three runs:
+    1. as fitted: the detector's box noise and drift (NOISE_KEYS) are scaled by the sequence's median jitter over the
+       scene's, for a detector fitted on other sequences need not jitter as this one's did (the pooled one jitters up
+       to twice as much as the TUD and ADL sequences' own);
+    2. as fitted, with that detector: the stop rate is scaled by the sequence's standing share over the scene's;
+    3. with that stop rate and a tenth of the noise: the deviation that the detector, SORT and the camera make by
+       themselves (the floor). The walkers' own deviation adds to the floor in squares, growing with their noise;
+       the noise is the one that brings the floor up to the sequence's. Where the floor is already above the
+       sequence's (the people are steadier than the boxes show, by how much the data cannot say) or the runs show
+       no response, the second run's noise is scaled by the sequence's deviation over the scene's.
+    The desired speed stays as fitted directly: the tracklets' speed differs from the people's in opposite ways in
+    the scene and the sequences (a scene's noisy boxes add speed to people standing; a sequence's walkers fragment
+    more than its standing people), and matching it through the detector moved the scenes' speeds away from the real
+    people's on two of the eight shared sequences and toward them on none. Returns the scene and the runs' keys and
     measurements."""
     walk = dict(raw["walk"])
     history: list[tuple[dict, np.ndarray]] = []
     if not np.all(np.isfinite(target)):
         return raw, history
 
-    def run(w: dict) -> np.ndarray:  # pooled over seeds, as many as give REFINE_WINDOWS windows (MAX_SEEDS at most)
-        values = []
+    def run(scene: dict, w: dict) -> np.ndarray:  # pooled over seeds, as many as give REFINE_WINDOWS windows
+        values, jitter = [], []
         for seed in range(seeds[0], seeds[0] + MAX_SEEDS):
-            values.append(window_values(frames_of(tracklets({**raw, "walk": w}, seed), length), frame_rate))
+            frames = frames_of(tracklets({**scene, "walk": w}, seed), length)
+            values.append(window_values(frames, frame_rate))
+            jitter.append(jitters(frames))
             if seed - seeds[0] + 1 >= len(seeds) and sum(len(v["speed"]) for v in values) >= REFINE_WINDOWS:
                 break
-        got = _measured({k: np.concatenate([v[k] for v in values]) for k in ("speed", "deviation")})
+        got = _measured({k: np.concatenate([v[k] for v in values]) for k in ("speed", "deviation")},
+                        np.concatenate(jitter))
         history.append((dict(w), got))
         return got
 
-    first = run(walk)
+    raw = _detector_scaled(raw, target[3] / run(raw, walk)[3])
+    first = run(raw, walk)
     if not np.all(np.isfinite(first)):
         return raw, history
-    low = {**walk, "speed": _scaled(walk["speed"], target[0] / max(first[0], 1e-6), "speed"),
-           "stop_rate": _scaled(max(walk["stop_rate"], 0.01), (target[2] + 0.02) / (first[2] + 0.02), "stop_rate"),
+    low = {**walk, "stop_rate": _scaled(max(walk["stop_rate"], 0.01), (target[2] + 0.02) / (first[2] + 0.02), "stop_rate"),
            "noise": round(max(walk["noise"] / 10, LIMITS["noise"][0]), 4)}
-    second = run(low)
+    second = run(raw, low)
     if not np.all(np.isfinite(second)):
         return raw, history
     slope = (first[1] ** 2 - second[1] ** 2) / max(walk["noise"] ** 2 - low["noise"] ** 2, 1e-12)
@@ -298,18 +322,45 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     return {**raw, "walk": final}, history
 
 
+def _detector_scaled(raw: dict, factor: float) -> dict:
+    """The scene `raw` with its detector's box noise and drift (NOISE_KEYS, as its sensor table or preset gives
+    them) times `factor`, within NOISE_REACH either way and the schema's range."""
+    if not math.isfinite(factor):
+        return raw
+    factor = float(np.clip(factor, 1 / NOISE_REACH, NOISE_REACH))
+    sensor = scn.from_mapping(raw, "fitted scene").sensor
+    scaled = {k: round(float(min(getattr(sensor, k) * factor, 1.0)), 4) for k in NOISE_KEYS}
+    return {**raw, "sensor": {**raw.get("sensor", {}), **scaled}}
+
+
 def _scaled(value: float, factor: float, key: str) -> float:
     """`value` times `factor`, the factor within REACH, the result within the schema's LIMITS."""
     factor = float(np.clip(factor, 1 / REACH[key], REACH[key]))
     return round(float(np.clip(value * factor, *LIMITS[key])), 4)
 
 
-def exits(width: float, height: float, margin: float) -> list[dict]:
-    """Exit doors just outside the world's left and right borders, four along each, so that walkers, who head for a
-    random exit, cross the scene and leave it, as the world's own goal (the far side) has them cross it (without
-    exits that goal is a point inside the world, where they would stay)."""
-    doors = []
+def doors(width: float, height: float, size: float, rows: tuple[float, float], heading: float | None,
+          births: float) -> list[dict]:
+    """Entry and exit doors at the left and right borders, four along each, spread over `rows` (the band of the
+    people's feet, as shares of the height), entries just inside (sharing `births` a frame) and exits just outside
+    (`size` px square): walkers, who head for a random exit, cross the scene at the depth where they walk and leave it
+    (an exit outside that band would send them into or out of the picture's depth, where the perspective bends a
+    straight walk; without exits the world's goal is a point inside it, where they would stay). Where the tracklets
+    walk one way (`heading`, degrees, within 45 of across), people enter on the side they come from and leave on the
+    other; else on both."""
+    across = None if heading is None else math.cos(math.radians(heading))
+    going = ("right",) if across is not None and across > SIDEWAYS else ("left",) if across is not None and \
+        across < -SIDEWAYS else ("left", "right")
+    coming = [{"left": "right", "right": "left"}[g] for g in going] if len(going) == 1 else going
+    out = []
     for f in (1 / 8, 3 / 8, 5 / 8, 7 / 8):
-        doors += [[-2 * margin, f * height - margin / 2, margin, margin],
-                  [width + margin, f * height - margin / 2, margin, margin]]
-    return [{"rect": [round(float(v), 1) for v in d], "role": "exit"} for d in doors]
+        y = (rows[0] + f * (rows[1] - rows[0])) * height
+        for side in coming:
+            x = -0.5 * size if side == "left" else width
+            out.append({"rect": [x, y - size / 4, 0.5 * size, 0.5 * size], "role": "entry",
+                        "birth_rate": births / (4 * len(coming))})
+        for side in going:
+            out.append({"rect": [-2 * size if side == "left" else width + size, y - size / 2, size, size],
+                        "role": "exit"})
+    return [{**d, "rect": [round(float(v), 1) for v in d["rect"]],
+             **({"birth_rate": round(d["birth_rate"], 4)} if "birth_rate" in d else {})} for d in out]

@@ -5,7 +5,6 @@ SORT (min_hits=3, max_age=3) through the env, tracklets shorter than MIN_FRAMES 
 to what they show (ground truth is never read, so gt/ may be missing or anything at all):
 - image size, frame rate and length: seqinfo.ini (or what the detections imply); env.max_steps is the length;
 - count: the mean number of tracklets per frame (the people in view at reset);
-- birth_rate: tracklet starts per frame after the first frame (people entering);
 - size and far_scale: a least-squares line height = a + b y_bottom over every tracklet box, as the standing world
   draws people (height linear in the feet's row): size is (median aspect ratio x, 1 x) the height at the bottom row,
   far_scale the height at the top row over that, clipped to the schema's range (where clipped, the near height is
@@ -19,10 +18,13 @@ to what they show (ground truth is never read, so gt/ may be missing or anything
 - how the people and the camera move (`mtt_sim.sim2real.fit_motion`): the scene runs at the sequence's frame rate
   (world.frame_rate), its people walk by the walking model (walk.model = "langevin", its keys fitted to the
   tracklets with the camera's common motion taken out, then refined by running the scene with its detector and
-  linking its detections as the sequence's were, `fit_scene(refine=True)`), toward exit doors just outside the left
-  and right borders, and its camera is the walking camera model fitted to the common motion where the tracklets show
-  one, else the still camera; the group's cv keys (speed, heading) stay, for walk.model = "off";
-- the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences).
+  linking its detections as the sequence's were, `fit_scene(refine=True)`), entering and leaving by doors at the
+  left and right borders in the band of their feet (births: tracklet starts per frame after the first frame, shared
+  by the entry doors; the group's own birth_rate is 0), and its camera is the walking camera model fitted to the
+  common motion where the tracklets show one, else the still camera; the group's cv keys (speed, heading) stay, for
+  walk.model = "off";
+- the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences), its box
+  noise and drift scaled to the sequence's own jitter by the refinement.
 `statistics` measures the same on any tracklets, so the scene's own detections are checked against the sequence's
 with one function.
 """
@@ -159,16 +161,18 @@ def fit(rows: np.ndarray, info) -> dict:
     if region[2] - region[0] < 0.01 or region[3] - region[1] < 0.01:
         region = [0.0, 0.0, 1.0, 1.0]
     heading, jitter = _heading(net[speeds * scale >= MOVING])
-    group = {"name": "people", "count": int(round(st["people"])), "birth_rate": round(min(st["births"], 100.0), 4),
+    births = min(st["births"], 100.0)
+    group = {"name": "people", "count": int(round(st["people"])), "birth_rate": 0.0,
              "region": [round(float(v), 3) for v in region], "size": [round(float(v), 1) for v in size],
              "motion": "cv", "speed": round(float(np.clip(np.median(speeds), 0.0, 200.0)), 3),
              "speed_jitter": round(float(np.clip(np.std(speeds) / max(np.mean(speeds), 1e-9), 0.0, 1.0)), 3),
              "heading": heading, "heading_jitter": jitter}
     moved = fit_motion.fit(rows, info)
+    doors = fit_motion.doors(W, H, size[1], (region[1], region[3]), heading if jitter < 180 else None, births)
     return {"name": _camel(info.name), "description": f"Fitted to the detections of {info.name} alone "
             "(mtt-sim fit-scene).", "world": {**world, **moved["world"]},
             "render": {"width": int(W), "height": int(H), **moved["render"]}, "walk": moved["walk"],
-            "env": {"max_steps": int(n)}, "groups": [group], "doors": fit_motion.exits(W, H, size[1])}
+            "env": {"max_steps": int(n)}, "groups": [group], "doors": doors}
 
 
 def _heading(net: np.ndarray) -> tuple[float, float]:

@@ -68,7 +68,7 @@ def simulate(config: WalkConfig, frame_rate: float, people: int = 150, duration:
     desired = np.array([walkers.desired_speed(rng) for _ in range(people)])
     pos, height = np.zeros((people, 2)), np.ones(people)
     vel = goal / 1e6 * (desired * walkers.dt)[:, None]
-    standing = rng.random(people) < config.stop_rate / max(config.stop_rate + config.go_rate, 1e-9)
+    standing = rng.random(people) < walkers.standing_share
     ids, frames = np.arange(people), []
     for _ in range(round(duration * frame_rate)):
         frames.append((ids, np.c_[pos[:, 0] - 0.2, pos[:, 1] - 1.0, np.full(people, 0.4), height]))
