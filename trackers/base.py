@@ -13,7 +13,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from . import plugins
+from .adapters import plugins
 
 
 @dataclass(frozen=True)
