@@ -36,7 +36,7 @@ class ByteTrack(Tracker):
         "mot20": Param(False, None, "the reference's MOT20 switch: no score fusion in the first round"),
         "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)"),
         "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper, as BoT-SORT; see "
-                                      "camera_motion.py): tracked, lost and new tracks moved with the image")}
+                                      "parts/camera_motion.py): tracked, lost and new tracks moved with the image")}
 
     @property
     def needs_frame(self) -> bool:

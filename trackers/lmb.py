@@ -207,7 +207,8 @@ class LabelledMultiBernoulli(Tracker):
         "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
         "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
         "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper; see "
-                                      "camera_motion.py): the predictions and last frame's births moved with the image"),
+                                      "parts/camera_motion.py): the predictions and last frame's births moved with "
+                                      "the image"),
         "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool",
                                  (0.3, 0.95), needs={"reid": True}),
         "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log"),

@@ -26,7 +26,7 @@ class Sort(Tracker):
         "iou_threshold": Param(0.3, "[0, 1]", "least IoU of a match", (0.05, 0.7)),
         "min_confidence": Param(0.0, None, "detections below this confidence are dropped", (0.0, 0.95)),
         "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper; see "
-                                      "camera_motion.py): the predictions moved with the image")}
+                                      "parts/camera_motion.py): the predictions moved with the image")}
 
     @property
     def needs_frame(self) -> bool:
