@@ -149,3 +149,18 @@ def test_import_trackers_does_not_find_this_project(tmp_path):
     name, spec = done.stdout.split(" ", 1)
     assert name == "mtt_sim.trackers"
     assert spec.strip() == "None" or str(ROOT / "trackers") not in spec
+
+
+def test_old_import_paths_still_work_and_warn(monkeypatch):
+    import importlib
+
+    from mtt_sim.trackers.parts import associations, kalman
+    monkeypatch.delitem(sys.modules, "mtt_sim.trackers.kalman", raising=False)
+    with pytest.warns(DeprecationWarning, match="mtt_sim.trackers.parts.kalman"):
+        old = importlib.import_module("mtt_sim.trackers.kalman")
+    assert old.box_model is kalman.box_model
+    sort = importlib.import_module("mtt_sim.trackers.sort")
+    with pytest.warns(DeprecationWarning, match="SortAssociation"):
+        assert sort.SortTracks is associations.SortAssociation
+    with pytest.raises(AttributeError):
+        sort.NoSuchName

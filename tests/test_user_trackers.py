@@ -3,7 +3,7 @@
 import textwrap
 
 import pytest
-from mtt_sim.trackers.adapters import plugins
+from mtt_sim.trackers import plugins
 
 from mtt_sim import trackers
 from mtt_sim.cli import main

@@ -13,7 +13,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .adapters import plugins
+from . import plugins
 
 
 @dataclass(frozen=True)

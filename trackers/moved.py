@@ -13,7 +13,7 @@ import warnings
 PACKAGE = __name__.rpartition(".")[0]
 MODULES = {name: f"parts.{name}" for name in ("appearance", "assignment", "camera_motion", "gaussian_mixture",
                                              "kalman", "management", "near_pairs", "reid")}
-MODULES.update({name: f"adapters.{name}" for name in ("external", "plugins", "roboflow")})
+MODULES.update({name: f"adapters.{name}" for name in ("external", "roboflow")})
 NAMES = {  # module: {old name: "new module:new name"}
     "sort": {"SortTracks": "parts.associations:SortAssociation", "associate": "parts.rounds:associate",
              "without": "parts.rounds:without", "paired_iou": "parts.assignment:paired_iou",

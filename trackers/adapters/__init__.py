@@ -1,2 +1,2 @@
-"""Trackers from elsewhere: any object with `update(detections)` (external), Roboflow's `trackers` package
-(roboflow), and tracker classes named by location or installed as plugins (plugins)."""
+"""Trackers from elsewhere: any object with `update(detections)` (external) and Roboflow's `trackers` package
+(roboflow). Tracker classes named by location or installed as plugins are found by the registry (../plugins.py)."""
