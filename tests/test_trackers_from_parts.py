@@ -8,7 +8,6 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import mtt_sim  # noqa: F401  (registers the envs)
 from mtt_sim import trackers
 from mtt_sim.lab.experiment import run_episodes
 

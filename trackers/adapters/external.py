@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-import numpy as np
-
 from ..base import Tracker, Tracks, detections, frame_of
 from .rows import to_tracks, track_rows
 
