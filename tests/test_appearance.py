@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mtt_sim.trackers.appearance import (bhattacharyya, gradient_descriptors, histograms, hs_bins, orientation_maps,
+from mtt_sim.trackers.parts.appearance import (bhattacharyya, gradient_descriptors, histograms, hs_bins, orientation_maps,
                                  rgb_bins)
 
 

@@ -6,7 +6,7 @@ import pytest
 
 from mtt_sim import trackers
 from mtt_sim.lab.experiment import run_episode
-from mtt_sim.trackers.camera_motion import IDENTITY, CameraMotion, warp_boxes, warp_centres
+from mtt_sim.trackers.parts.camera_motion import IDENTITY, CameraMotion, warp_boxes, warp_centres
 
 
 def textured(seed=0, size=(240, 320)):

@@ -141,7 +141,7 @@ def test_new_then_normal_then_vanished_and_ended_after_three_misses():
     t, out = run([a], 16, **PAPER)
     assert out[0] == ([1], [NEW]) and out[5] == ([1], [NORMAL])
     assert [o[1] for o in out[10:13]] == [[VANISHED]] * 3 and all(o[0] == [] for o in out[10:])
-    assert len(t.book) == 0 and t.ended.ids.tolist() == [1]
+    assert len(t.tracks) == 0 and t.ended.ids.tolist() == [1]
 
 
 def test_a_confirmed_target_stays_confirmed_through_a_miss():
@@ -173,7 +173,7 @@ def test_a_target_reappearing_soon_is_revived_with_its_id():
     a = lambda k: (20 + 2 * k, 50) if not 10 <= k < 14 else None  # noqa: E731 (4 frames missed: ended, then back)
     t, out = run([a], 20)
     assert out[13][0] == [] and out[14] == ([1], [REVIVED])
-    assert t.book.next_id == 2  # no new target was started
+    assert t.tracks.next_id == 2  # no new target was started
 
 
 def test_a_target_reappearing_too_late_is_new():
@@ -187,7 +187,7 @@ def test_fragments_of_one_target_are_a_split_and_update_it():
         return lambda k: (20 + 2 * k, 50 + sign * 4) if k >= 10 else ((20 + 2 * k, 50) if sign > 0 else None)
     t, out = run([halves(1), halves(-1)], 14)
     assert out[10][1] == [SPLIT] and out[12][0] == [1]  # one target, not two
-    assert abs(t.book.kf.x[0, 1] - 50) < 2  # the combined update sits between the fragments
+    assert abs(t.tracks.kf.x[0, 1] - 50) < 2  # the combined update sits between the fragments
 
 
 def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
@@ -195,8 +195,8 @@ def test_two_targets_merging_into_one_blob_are_occluded_and_sit_at_the_blob():
     b = lambda k: (20 + 2 * k, 80) if k < 8 else ((20 + 2 * k, 65) if k < 12 else (20 + 2 * k, 80))  # noqa: E731
     t, out = run([a, b], 9, meas_sigma=8.0, **PAPER)  # the paper's rule: at the blob, at rest
     assert out[8][1] == [OCCLUDED, OCCLUDED] and sorted(out[8][0]) == [1, 2]
-    np.testing.assert_allclose(t.book.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
-    np.testing.assert_allclose(t.book.kf.x[:, 2:], 0.0)
+    np.testing.assert_allclose(t.tracks.kf.x[:, :2], [[36, 65], [36, 65]], atol=1e-9)
+    np.testing.assert_allclose(t.tracks.kf.x[:, 2:], 0.0)
 
 
 def test_two_targets_apart_sharing_one_measurement_are_not_merged():
@@ -206,7 +206,7 @@ def test_two_targets_apart_sharing_one_measurement_are_not_merged():
     b = lambda k: (20 + 2 * k, 80) if k != 8 else (36, 65)  # noqa: E731
     t, out = run([a, b], 9, meas_sigma=8.0)
     assert out[8][1] == [NORMAL, NORMAL] and sorted(out[8][0]) == [1, 2]
-    assert (np.abs(t.book.kf.x[:, 2]) > 1).all()
+    assert (np.abs(t.tracks.kf.x[:, 2]) > 1).all()
     t, out = run([a, b], 9, meas_sigma=8.0, merge_needs_overlap=False)
     assert out[8][1] == [OCCLUDED, OCCLUDED]
 
@@ -279,7 +279,7 @@ def test_a_duplicate_sharing_one_blob_for_long_is_dropped():
     a = lambda k: (20 + 2 * k, 50) if k < 3 else (20 + 2 * k, 54)  # noqa: E731
     b = lambda k: (20 + 2 * k, 58) if k < 3 else None  # noqa: E731  (merged into a's blob from frame 3 on)
     t, out = run([a, b], 30, meas_sigma=6.0, merge_frames=10, **PAPER)
-    assert out[5][1] == [OCCLUDED, OCCLUDED] and len(t.book) == 1 and out[-1][0] == [1]
+    assert out[5][1] == [OCCLUDED, OCCLUDED] and len(t.tracks) == 1 and out[-1][0] == [1]
 
 
 # ------------------------------------------------------------------ jpda_exact's budget (issue 37)

@@ -1,5 +1,6 @@
 """The package's shape: data flows one way (no module imports one that imports it back, lazy imports included), the
-trackers never import the simulator, no module is over 500 lines, and `import trackers` is not this project."""
+trackers never import the simulator, a tracker imports only the base and the parts (never another tracker), no
+module is over 500 lines, and `import trackers` is not this project."""
 
 import ast
 import subprocess
@@ -102,6 +103,40 @@ def test_the_trackers_never_import_the_simulator():
             assert not outside, f"{name} imports {outside}"
 
 
+def layer_breaks(edges: dict[str, set[str]], tracker_modules: set[str]) -> list[str]:
+    """The imports that break the trackers' layers: a module defining a tracker imports nothing but the base, the
+    parts and the adapters' helpers (modules defining no tracker); a part imports nothing but parts and the base."""
+    base, parts = "mtt_sim.trackers.base", "mtt_sim.trackers.parts"
+    out = []
+    for name, targets in sorted(edges.items()):
+        if name in tracker_modules:
+            allowed = lambda t: t == base or t.startswith(parts) or (t.startswith("mtt_sim.trackers.adapters")
+                                                                      and t not in tracker_modules)
+        elif name.startswith(parts):
+            allowed = lambda t: t == base or t.startswith(parts)
+        else:
+            continue
+        out += [f"{name} imports {t}" for t in sorted(targets) if not allowed(t)]
+    return out
+
+
+def test_the_layer_check_finds_a_tracker_importing_another_and_a_part_importing_a_tracker():
+    edges = {"mtt_sim.trackers.ocsort": {"mtt_sim.trackers.sort", "mtt_sim.trackers.parts.rounds"},
+             "mtt_sim.trackers.sort": {"mtt_sim.trackers.base", "mtt_sim.sim.world"},
+             "mtt_sim.trackers.parts.management": {"mtt_sim.trackers.parts.kalman", "mtt_sim.trackers.bytetrack"}}
+    trackers = {"mtt_sim.trackers.ocsort", "mtt_sim.trackers.sort", "mtt_sim.trackers.bytetrack"}
+    assert layer_breaks(edges, trackers) == ["mtt_sim.trackers.ocsort imports mtt_sim.trackers.sort",
+                                             "mtt_sim.trackers.parts.management imports mtt_sim.trackers.bytetrack",
+                                             "mtt_sim.trackers.sort imports mtt_sim.sim.world"]
+
+
+def test_a_tracker_imports_only_the_base_and_the_parts():
+    from mtt_sim.trackers.registry import BUILT_IN
+    tracker_modules = {cls.__module__ for cls in BUILT_IN}
+    assert {"mtt_sim.trackers.sort", "mtt_sim.trackers.adapters.roboflow"} <= tracker_modules
+    assert layer_breaks(graph(), tracker_modules) == []
+
+
 @pytest.mark.parametrize("name", sorted(modules()))
 def test_no_module_is_over_500_lines(name):
     lines = len(modules()[name].read_text().splitlines())
@@ -114,3 +149,18 @@ def test_import_trackers_does_not_find_this_project(tmp_path):
     name, spec = done.stdout.split(" ", 1)
     assert name == "mtt_sim.trackers"
     assert spec.strip() == "None" or str(ROOT / "trackers") not in spec
+
+
+def test_old_import_paths_still_work_and_warn(monkeypatch):
+    import importlib
+
+    from mtt_sim.trackers.parts import associations, kalman
+    monkeypatch.delitem(sys.modules, "mtt_sim.trackers.kalman", raising=False)
+    with pytest.warns(DeprecationWarning, match="mtt_sim.trackers.parts.kalman"):
+        old = importlib.import_module("mtt_sim.trackers.kalman")
+    assert old.box_model is kalman.box_model
+    sort = importlib.import_module("mtt_sim.trackers.sort")
+    with pytest.warns(DeprecationWarning, match="SortAssociation"):
+        assert sort.SortTracks is associations.SortAssociation
+    with pytest.raises(AttributeError):
+        sort.NoSuchName

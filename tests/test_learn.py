@@ -7,7 +7,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from helpers import write_sequence
 from mtt_sim.trackers.learned import load_policy, save_policy
-from mtt_sim.trackers.management import FEATURES, SORT_RULES, Candidates, decisions
+from mtt_sim.trackers.parts.management import FEATURES, SORT_RULES, Candidates, decisions
 
 import mtt_sim  # noqa: F401  (registers the env ids)
 from mtt_sim import trackers

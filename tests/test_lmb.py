@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from mtt_sim import trackers
 from helpers import placed, run_tracker, still, tiny
 from mtt_sim.env import TrackingEnv
-from mtt_sim.trackers import gaussian_mixture as gm
+from mtt_sim.trackers.parts import gaussian_mixture as gm
 from mtt_sim.trackers.lmb import group_update
 
 INFO = {"image_size": (640, 480)}

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mtt_sim import trackers
-from mtt_sim.trackers.kalman import box_model
+from mtt_sim.trackers.parts.kalman import box_model
 
 W, H = 40.0, 100.0
 
@@ -69,7 +69,7 @@ def test_re_update_rewinds_to_the_first_miss_and_runs_the_filter_along_the_gap()
     for _ in range(10):
         t.update(obs(*box(100.0)))
     t.update(obs())
-    first_miss = t.kf.x.copy(), t.kf.P.copy()
+    first_miss = t.tracks.kf.x.copy(), t.tracks.kf.P.copy()
     for _ in range(9):
         t.update(obs())
     t.update(obs(*box(133.0)))
@@ -92,8 +92,8 @@ def test_re_update_rewinds_to_the_first_miss_and_runs_the_filter_along_the_gap()
         if i < 11:
             x, P = m.F @ x, m.F @ P @ m.F.T + m.Q
     x, P = kalman_update(x, P, z_new)
-    np.testing.assert_allclose(t.kf.x[0], x, rtol=1e-9)
-    np.testing.assert_allclose(t.kf.P[0], P, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(t.tracks.kf.x[0], x, rtol=1e-9)
+    np.testing.assert_allclose(t.tracks.kf.P[0], P, rtol=1e-6, atol=1e-9)
 
 
 def test_momentum_prefers_the_detection_along_the_track_s_direction():

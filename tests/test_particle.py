@@ -7,7 +7,7 @@ import pytest
 import mtt_sim  # noqa: F401  (registers the env ids)
 from mtt_sim import trackers
 from helpers import leaving_book, run_tracker
-from mtt_sim.trackers.particle import systematic_resample
+from mtt_sim.trackers.parts.particles import systematic_resample
 
 
 def episode(spec, steps=200, seed=0):

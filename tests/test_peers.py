@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mtt_sim import trackers
-from mtt_sim.trackers import roboflow
+from mtt_sim.trackers.adapters import roboflow
 
 STAND_IN = '''
 import numpy as np

@@ -5,7 +5,7 @@ import numpy as np
 
 from mtt_sim import trackers
 from mtt_sim import cli
-from mtt_sim.trackers import reid
+from mtt_sim.trackers.parts import reid
 
 
 def test_siltp_code_of_a_hand_made_neighbourhood():

@@ -12,9 +12,9 @@ import mtt_sim  # noqa: F401
 from mtt_sim import trackers
 from helpers import run_tracker
 from mtt_sim.lab.episode import Episode
-from mtt_sim.trackers.assignment import assign, corner_iou, lapjv, murty, plus_one_iou
-from mtt_sim.trackers.kalman import KalmanBank, box_model, point_model
-from mtt_sim.trackers.sort import corners_to_measurement, state_to_corners
+from mtt_sim.trackers.parts.assignment import assign, corner_iou, lapjv, murty, plus_one_iou
+from mtt_sim.trackers.parts.kalman import KalmanBank, box_model, point_model
+from mtt_sim.trackers.parts.boxes import corners_to_measurement, state_to_corners
 
 BASELINES = ["sort", "iou", "gnn", "bytetrack"]
 FRAMES = 30
@@ -206,7 +206,7 @@ def test_the_trackers_of_the_paper_comparisons_are_tunable():
     for name in ("gnn", "gmphd", "lmb", "jpda", "jpda_exact", "pf", "ipf", "pcpf", "sort", "bytetrack", "iou", "ocsort"):
         assert trackers.base.search_space(name), name
     gmphd, lmb = (trackers.base.REGISTRY[n].parameters for n in ("gmphd", "lmb"))
-    assert all(gmphd[k].search == lmb[k].search != () for k in trackers.gaussian_mixture.MODEL_PARAMETERS)
+    assert all(gmphd[k].search == lmb[k].search != () for k in trackers.parts.gaussian_mixture.MODEL_PARAMETERS)
     assert trackers.base.search_space("jpda_exact") == trackers.base.search_space("jpda")  # its caps are not tuned
     assert "conflict_ratio" in trackers.base.search_space("ipf")
     assert "conflict_ratio" not in trackers.base.search_space("pcpf")  # unread without the interaction

@@ -5,15 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import corners, lapjv, plus_one_iou
-from .base import Param, Tracker, Tracks, detections, frame_of, register
-from .camera_motion import METHODS, CameraMotion, warp_centres
-from .kalman import xyah_initiate, xyah_predict, xyah_update
+from .base import Param, Tracker, Tracks, detections, frame_of
+from .parts.assignment import corners, lapjv, plus_one_iou
+from .parts.boxes import tlwh_to_xyah, xyah_to_corners, xyah_to_tlwh
+from .parts.camera_motion import METHODS, CameraMotion, warp_centres
+from .parts.kalman import xyah_initiate, xyah_predict, xyah_update
+from .parts.track_table import TrackTable
 
 TRACKED, LOST, REMOVED = 1, 2, 3  # the reference's TrackState (New = 0 is never stored)
 
 
-@register
 class ByteTrack(Tracker):
     """Detections above track_thresh are high, those between 0.1 and track_thresh low. Tracked and lost tracks
     (lost ones with their height velocity zeroed) predict with a Kalman filter on (cx, cy, aspect, height) whose noise
@@ -35,7 +36,7 @@ class ByteTrack(Tracker):
         "mot20": Param(False, None, "the reference's MOT20 switch: no score fusion in the first round"),
         "frame_rate": Param(30.0, "(0, inf)", "the video's frames per second (scales track_buffer)"),
         "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper, as BoT-SORT; see "
-                                      "camera_motion.py): tracked, lost and new tracks moved with the image")}
+                                      "parts/camera_motion.py): tracked, lost and new tracks moved with the image")}
 
     @property
     def needs_frame(self) -> bool:
@@ -43,46 +44,43 @@ class ByteTrack(Tracker):
 
     def reset(self, info=None):
         self.camera = CameraMotion(self.params["cmc"])
-        self.mean, self.cov = np.zeros((0, 8)), np.zeros((0, 8, 8))
-        self.ids, self.state = np.zeros(0, np.int64), np.zeros(0, np.int8)
-        self.activated = np.zeros(0, bool)
-        self.score = np.zeros(0)
-        self.last_frame, self.start_frame = np.zeros(0, np.int64), np.zeros(0, np.int64)
-        self.tracked: list[int] = []  # rows, in the reference's list order
+        self.tracks = TrackTable(mean=(np.float64, (8,)), cov=(np.float64, (8, 8)), state=np.int8, activated=bool,
+                                 score=np.float64)
+        self.tracked: list[int] = []  # rows of the table, in the reference's list order
         self.lost: list[int] = []
         self.removed_ids: set[int] = set()
-        self.frame, self.next_id = 0, 1
 
     def update(self, obs) -> Tracks:
         p = self.params
         dets = detections(obs)
-        self.frame += 1
+        self.tracks.tick()
         xyxy = corners(dets)  # the reference is given x1, y1, x2, y2
         tlwh = np.concatenate([xyxy[:, :2], xyxy[:, 2:] - xyxy[:, :2]], axis=1)
         score = dets[:, 4]
         high = np.flatnonzero(score > p["track_thresh"])
         low = np.flatnonzero((score > 0.1) & (score < p["track_thresh"]))
-        unconfirmed = [r for r in self.tracked if not self.activated[r]]
-        pool = _joint([r for r in self.tracked if self.activated[r]], self.lost)
+        unconfirmed = [r for r in self.tracked if not self.tracks.activated[r]]
+        pool = _joint([r for r in self.tracked if self.tracks.activated[r]], self.lost)
         self._predict(pool)
         if self.needs_frame:
             moved = pool + unconfirmed
             warp = self.camera.estimate(frame_of(obs), tlwh)
-            self.mean[moved], self.cov[moved] = warp_centres(self.mean[moved], self.cov[moved], warp,
-                                                             "centre_aspect_height")
+            tracks = self.tracks
+            tracks.mean[moved], tracks.cov[moved] = warp_centres(tracks.mean[moved], tracks.cov[moved], warp,
+                                                                 "centre_aspect_height")
         activated, refound, lost_now, removed_now = [], [], [], []
         # every IoU the three rounds read: a round's tracks are not corrected before it (unconfirmed ones never move)
-        iou = plus_one_iou(xyah_to_corners(self.mean[pool + unconfirmed]), corners(tlwh))
+        iou = plus_one_iou(xyah_to_corners(self.tracks.mean[pool + unconfirmed]), corners(tlwh))
         n = len(pool)
 
         # first association: tracked and lost tracks with the high detections
         matches, left_tracks, left_high = self._associate(iou[:n][:, high], score[high], p["match_thresh"])
         matched = [pool[t] for t in matches[:, 0].tolist()]
         for r in matched:
-            (activated if self.state[r] == TRACKED else refound).append(r)
+            (activated if self.tracks.state[r] == TRACKED else refound).append(r)
         corrected, by = [matched], [high[matches[:, 1]]]  # corrected together at the end: no round reads another's
         # second association: tracked tracks left with the low detections
-        rest_at = [t for t in left_tracks.tolist() if self.state[pool[t]] == TRACKED]
+        rest_at = [t for t in left_tracks.tolist() if self.tracks.state[pool[t]] == TRACKED]
         rest = [pool[t] for t in rest_at]
         matches, still, _ = self._associate(iou[rest_at][:, low], None, 0.5)
         matched = [rest[t] for t in matches[:, 0].tolist()]
@@ -90,8 +88,8 @@ class ByteTrack(Tracker):
         corrected.append(matched)
         by.append(low[matches[:, 1]])
         for t in still.tolist():
-            if self.state[rest[t]] != LOST:
-                self.state[rest[t]] = LOST
+            if self.tracks.state[rest[t]] != LOST:
+                self.tracks.state[rest[t]] = LOST
                 lost_now.append(rest[t])
         # tracks born last frame with the high detections left
         high = high[left_high]
@@ -102,7 +100,7 @@ class ByteTrack(Tracker):
         by.append(high[matches[:, 1]])
         self._correct(sum(corrected, []), np.concatenate(by), tlwh, score)
         for t in left_new.tolist():
-            self.state[unconfirmed[t]] = REMOVED
+            self.tracks.state[unconfirmed[t]] = REMOVED
             removed_now.append(unconfirmed[t])
         # new tracks
         born = high[left_high]
@@ -111,18 +109,18 @@ class ByteTrack(Tracker):
         # lost too long
         patience = int(p["frame_rate"] / 30.0 * p["track_buffer"])
         for r in self.lost:
-            if self.frame - self.last_frame[r] > patience:
-                self.state[r] = REMOVED
+            if self.tracks.misses[r] > patience:
+                self.tracks.state[r] = REMOVED
                 removed_now.append(r)
         self._rearrange(activated, refound, lost_now, removed_now)
-        out = [r for r in self.tracked if self.activated[r]]
-        return Tracks.of(self.ids[out], xyah_to_tlwh(self.mean[out]), self.score[out])
+        out = [r for r in self.tracked if self.tracks.activated[r]]
+        return Tracks.of(self.tracks.ids[out], xyah_to_tlwh(self.tracks.mean[out]), self.tracks.score[out])
 
     def _predict(self, rows: list[int]) -> None:
         if rows:
-            mean = self.mean[rows]
-            mean[self.state[rows] != TRACKED, 7] = 0
-            self.mean[rows], self.cov[rows] = xyah_predict(mean, self.cov[rows])
+            mean = self.tracks.mean[rows]
+            mean[self.tracks.state[rows] != TRACKED, 7] = 0
+            self.tracks.mean[rows], self.tracks.cov[rows] = xyah_predict(mean, self.tracks.cov[rows])
 
     def _associate(self, iou: np.ndarray, score: np.ndarray | None, limit: float):
         """(matches (track index, detection index), unmatched track indices, unmatched detection indices) of tracks and
@@ -139,9 +137,10 @@ class ByteTrack(Tracker):
         if they were lost)."""
         if not rows:
             return
-        self.mean[rows], self.cov[rows] = xyah_update(self.mean[rows], self.cov[rows], tlwh_to_xyah(tlwh[dets]))
-        self.state[rows], self.activated[rows], self.score[rows], self.last_frame[rows] = TRACKED, True, score[dets], \
-            self.frame
+        tracks = self.tracks
+        tracks.mean[rows], tracks.cov[rows] = xyah_update(tracks.mean[rows], tracks.cov[rows], tlwh_to_xyah(tlwh[dets]))
+        tracks.state[rows], tracks.activated[rows], tracks.score[rows] = TRACKED, True, score[dets]
+        tracks.matched(rows)
 
     def _start(self, tlwh: np.ndarray, score: np.ndarray) -> list[int]:
         """New tracks (rows appended), activated at once only in the first frame."""
@@ -149,22 +148,17 @@ class ByteTrack(Tracker):
         if not n:
             return []
         mean, cov = xyah_initiate(tlwh_to_xyah(tlwh))
-        first = len(self.ids)
-        grow = {"mean": mean, "cov": cov, "ids": np.arange(self.next_id, self.next_id + n),
-                "state": np.full(n, TRACKED, np.int8), "activated": np.full(n, self.frame == 1), "score": score,
-                "last_frame": np.full(n, self.frame), "start_frame": np.full(n, self.frame)}
-        for name, new in grow.items():
-            setattr(self, name, np.concatenate([getattr(self, name), new]))
-        self.next_id += n
+        first = len(self.tracks.ids)
+        self.tracks.add(n, mean=mean, cov=cov, state=TRACKED, activated=self.tracks.frame == 1, score=score)
         return list(range(first, first + n))
 
     def _rearrange(self, activated, refound, lost_now, removed_now) -> None:
         """The reference's list bookkeeping at the end of a frame, in its order (ids and duplicates depend on it)."""
-        tracked = _joint(_joint([r for r in self.tracked if self.state[r] == TRACKED], activated), refound)
+        tracked = _joint(_joint([r for r in self.tracked if self.tracks.state[r] == TRACKED], activated), refound)
         in_tracked = set(tracked)
         lost = [r for r in self.lost if r not in in_tracked] + lost_now
-        lost = [r for r in lost if int(self.ids[r]) not in self.removed_ids]
-        self.removed_ids.update(int(self.ids[r]) for r in removed_now)
+        lost = [r for r in lost if int(self.tracks.ids[r]) not in self.removed_ids]
+        self.removed_ids.update(int(self.tracks.ids[r]) for r in removed_now)
         self.tracked, self.lost = self._without_duplicates(tracked, lost)
         self._compact()
 
@@ -172,9 +166,9 @@ class ByteTrack(Tracker):
         """A tracked and a lost track with 1 - IoU < 0.15: the one that has been tracked for fewer frames goes."""
         if not tracked or not lost:
             return tracked, lost
-        boxes = xyah_to_corners(self.mean[tracked + lost])
+        boxes = xyah_to_corners(self.tracks.mean[tracked + lost])
         close = np.argwhere(1 - plus_one_iou(boxes[:len(tracked)], boxes[len(tracked):]) < 0.15)
-        age = self.last_frame - self.start_frame
+        age = self.tracks.age - self.tracks.misses  # frames from a track's birth to its last match
         drop_a = {p for p, q in close if not age[tracked[p]] > age[lost[q]]}
         drop_b = {q for p, q in close if age[tracked[p]] > age[lost[q]]}
         return ([r for i, r in enumerate(tracked) if i not in drop_a], [r for i, r in enumerate(lost) if i not in drop_b])
@@ -182,13 +176,12 @@ class ByteTrack(Tracker):
     def _compact(self) -> None:
         """Drop the rows of tracks in neither list (their ids stay in removed_ids), keeping the lists' order."""
         alive = self.tracked + self.lost
-        if len(self.ids) < 2 * len(alive) + 64:
+        if len(self.tracks.ids) < 2 * len(alive) + 64:
             return
-        keep = np.array(sorted(alive), np.intp)
-        new_row = np.full(len(self.ids), -1)
-        new_row[keep] = np.arange(len(keep))
-        for name in ("mean", "cov", "ids", "state", "activated", "score", "last_frame", "start_frame"):
-            setattr(self, name, getattr(self, name)[keep])
+        keep = np.zeros(len(self.tracks.ids), bool)
+        keep[alive] = True
+        new_row = np.cumsum(keep) - 1
+        self.tracks.keep(keep)
         self.tracked, self.lost = [int(new_row[r]) for r in self.tracked], [int(new_row[r]) for r in self.lost]
 
 
@@ -196,33 +189,3 @@ def _joint(a: list[int], b: list[int]) -> list[int]:
     """The reference's joint_stracks: the rows of `a`, then those of `b` not in `a`."""
     seen = set(a)
     return a + [r for r in dict.fromkeys(b) if r not in seen]
-
-
-def xyah_to_tlwh(m: np.ndarray) -> np.ndarray:
-    """Filter means (cx, cy, aspect, height, ...) -> boxes x, y, w, h."""
-    out = np.empty((len(m), 4))
-    out[:, 2] = m[:, 2] * m[:, 3]
-    out[:, 0] = m[:, 0] - out[:, 2] / 2
-    out[:, 1] = m[:, 1] - m[:, 3] / 2
-    out[:, 3] = m[:, 3]
-    return out
-
-
-def xyah_to_corners(m: np.ndarray) -> np.ndarray:
-    """Filter means (cx, cy, aspect, height, ...) -> boxes x1, y1, x2, y2 (as corners(xyah_to_tlwh(m)), in one go)."""
-    out = np.empty((len(m), 4))
-    width = m[:, 2] * m[:, 3]
-    out[:, 0] = m[:, 0] - width / 2
-    out[:, 1] = m[:, 1] - m[:, 3] / 2
-    out[:, 2] = out[:, 0] + width
-    out[:, 3] = out[:, 1] + m[:, 3]
-    return out
-
-
-def tlwh_to_xyah(tlwh: np.ndarray) -> np.ndarray:
-    """Boxes x, y, w, h -> the filter's measurement cx, cy, aspect w / h, height."""
-    out = np.empty((len(tlwh), 4))
-    out[:, :2] = tlwh[:, :2] + tlwh[:, 2:4] / 2
-    out[:, 2] = tlwh[:, 2] / tlwh[:, 3]
-    out[:, 3] = tlwh[:, 3]
-    return out

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections
 
 
-@register
 class Echo(Tracker):
     """Reports each frame's detections (at or above min_confidence) as tracks numbered 1..n afresh every frame:
     no filtering, no identity. What a tracker must beat."""

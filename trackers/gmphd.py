@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import gaussian_mixture as gm
-from .assignment import chi2_gate
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections
+from .parts import gaussian_mixture as gm
+from .parts.assignment import chi2_gate
 
 
-@register
 class GaussianMixturePhd(Tracker):
     """The PHD (first moment of the multi-target density) as a Gaussian mixture over (x, y, w, h, vx, vy, vw, vh).
     Predict: weights times the survival probability. Update (Vo and Ma 2006, Table I): missed components with

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import assign, chi2_gate
-from .base import Param, Tracker, Tracks, covariance_ellipse, detections, register
-from .kalman import KalmanBank, point_model
-from .trackbook import CONFIRMED, TENTATIVE, TrackBook
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections
+from .parts.assignment import assign, chi2_gate
+from .parts.kalman import KalmanBank, point_model
+from .parts.track_table import CONFIRMED, TENTATIVE, TrackTable
 
 
-@register
 class Gnn(Tracker):
     """Each track filters its box centre with a constant-velocity Kalman filter; detections inside the
     chi-square gate (gate_probability, 2 degrees of freedom) are assigned by minimum total squared Mahalanobis
@@ -33,7 +32,8 @@ class Gnn(Tracker):
 
     def reset(self, info=None):
         p = self.params
-        self.book = TrackBook(KalmanBank(point_model(p["accel_sigma"], p["meas_sigma"])))
+        self.tracks = TrackTable(KalmanBank(point_model(p["accel_sigma"], p["meas_sigma"])), state=np.int8, score=np.float64,
+                                 last_box=(np.float64, (4,)))  # the last associated detection's box and score
         self.gate = chi2_gate(2, p["gate_probability"])
         self._gates = (np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2, 2)))
 
@@ -42,19 +42,23 @@ class Gnn(Tracker):
         return [covariance_ellipse(centre, S, self.gate, id=int(i)) for i, centre, S in zip(*self._gates)]
 
     def update(self, obs) -> Tracks:
-        p, book = self.params, self.book
+        p, tracks = self.params, self.tracks
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["min_confidence"]]
         centres = dets[:, :2] + dets[:, 2:4] / 2
-        book.predict()
-        cost = book.kf.mahalanobis(centres) if len(book) else np.zeros((0, len(dets)))
-        self._gates = (book.ids.copy(), book.kf.measurement(), book.kf.innovation_covariance())
+        tracks.kf.predict()
+        tracks.tick()
+        cost = tracks.kf.mahalanobis(centres) if len(tracks) else np.zeros((0, len(dets)))
+        self._gates = (tracks.ids.copy(), tracks.kf.measurement(), tracks.kf.innovation_covariance())
         matches, _, new = assign(cost, self.gate)
         rows, cols = matches[:, 0], matches[:, 1]
-        book.hit(rows, dets[cols, :4], dets[cols, 4], centres[cols])
-        book.state[(book.state == TENTATIVE) & (book.hits >= p["min_hits"])] = CONFIRMED
-        book.keep(np.where(book.state == TENTATIVE, book.misses == 0, book.misses <= p["max_age"]))
-        book.add(dets[new, :4], dets[new, 4], centres[new], state=CONFIRMED if p["min_hits"] <= 1 else TENTATIVE)
-        report = (book.state == CONFIRMED) & ((book.misses == 0) | p["coast"])
-        size = book.boxes[report, 2:]
-        return Tracks.of(book.ids[report], np.c_[book.kf.x[report, :2] - size / 2, size], book.score[report])
+        tracks.matched(rows)
+        tracks.last_box[rows], tracks.score[rows] = dets[cols, :4], dets[cols, 4]
+        tracks.kf.update(rows, centres[cols])
+        tracks.state[(tracks.state == TENTATIVE) & (tracks.hits >= p["min_hits"])] = CONFIRMED
+        tracks.keep(np.where(tracks.state == TENTATIVE, tracks.misses == 0, tracks.misses <= p["max_age"]))
+        tracks.add(len(new), centres[new], hits=1, streak=1, state=CONFIRMED if p["min_hits"] <= 1 else TENTATIVE,
+                   score=dets[new, 4], last_box=dets[new, :4])
+        report = (tracks.state == CONFIRMED) & ((tracks.misses == 0) | p["coast"])
+        size = tracks.last_box[report, 2:]
+        return Tracks.of(tracks.ids[report], np.c_[tracks.kf.x[report, :2] - size / 2, size], tracks.score[report])

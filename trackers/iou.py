@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import corner_iou, corners
-from .base import Param, Tracker, Tracks, detections, register
+from .base import Param, Tracker, Tracks, detections
+from .parts.assignment import corner_iou, corners
 
 
-@register
 class IouTracker(Tracker):
     """As the reference code (bochinski/iou-tracker, `track_iou`): detections under sigma_l are dropped; each active
     track, in order, takes the remaining detection that overlaps its last box most if that IoU reaches sigma_iou,

@@ -6,10 +6,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from .appearance import bhattacharyya, histograms, hs_bins
-from .base import Param, Tracker, Tracks, frame_of, register
-from .particle import crop_around, image_size, initial_targets, systematic_resample
-from .near_pairs import near_in_x_and_y
+from .base import Param, Tracker, Tracks, frame_of
+from .parts.appearance import bhattacharyya, histograms, hs_bins
+from .parts.near_pairs import near_in_x_and_y
+from .parts.particles import crop_around, image_size, initial_targets, systematic_resample
 
 
 def conflict_set(centres: np.ndarray, sizes: np.ndarray, ratio: float) -> np.ndarray:
@@ -42,7 +42,6 @@ def _reach(sizes: np.ndarray, ratio: float) -> np.ndarray:
     return np.maximum(reach.max(axis=1, initial=0.0), 0.0) * (1 + 1e-9) + 1e-9  # rounding: keep every candidate
 
 
-@register
 class InteractiveParticleFilter(Tracker):
     """One particle set of N particles per initial target (boxes from env.reset's info["init_boxes"], as the paper
     initialises by hand). Particles are drawn around the target's previous estimate with a Brownian step of
@@ -154,7 +153,6 @@ class InteractiveParticleFilter(Tracker):
                 for t in range(len(xy))]
 
 
-@register
 class PathConsistencyParticleFilter(InteractiveParticleFilter):
     """The baseline the interactive filter's paper compares against: independent particle filters (200 particles
     each, the paper's count for it) that assume a consistent path. Particles are drawn around the constant-velocity prediction, and while a

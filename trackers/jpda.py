@@ -14,13 +14,11 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
-from .assignment import chi2_gate, murty
-from .base import Param, Tracker, Tracks, covariance_ellipse, detections, register
-from .kalman import KalmanBank, point_model
-from .trackbook import CONFIRMED, TrackBook
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections
+from .parts.assignment import chi2_gate, clusters, murty
+from .parts.kalman import KalmanBank, point_model
+from .parts.track_table import CONFIRMED, TrackTable
 
 
 ENUMERATE_UP_TO = 256  # clusters with at most this many joint events (an upper bound) are enumerated
@@ -125,15 +123,6 @@ def _most_probable(beta: np.ndarray) -> np.ndarray:
     return np.argmax(beta[:, 1:], axis=1) if beta.shape[1] > 1 else np.zeros(len(beta), int)
 
 
-def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cluster labels of targets (rows) and measurements (columns) linked by gated pairs (connected components)."""
-    n, m = gated.shape
-    rows, cols = np.nonzero(gated)
-    graph = coo_matrix((np.ones(len(rows)), (rows, n + cols)), shape=(n + m, n + m))
-    labels = connected_components(graph, directed=False)[1]
-    return labels[:n], labels[n:]
-
-
 def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
     """Each target's motion situation from beta' (measurements x targets), and the measurements left unexplained.
 
@@ -154,7 +143,6 @@ def situations(beta_prime: np.ndarray) -> tuple[list[str], np.ndarray]:
     return kind.tolist(), np.flatnonzero(per_row == 0)
 
 
-@register
 class Jpda(Tracker):
     """Wan, Wang and Yuan (2011): each target's box centre is Kalman-filtered with a constant-velocity model;
     measurements (detection centres) within the gate d^2 <= chi2(gate_probability, 2) form the validation matrix; targets sharing
@@ -229,11 +217,11 @@ class Jpda(Tracker):
     def reset(self, info=None):
         p = self.params
         self.model = point_model(p["accel_sigma"], p["meas_sigma"], p["speed_sigma0"])
-        # The targets: streak counts frames in a row with a measurement, together frames in one blob, boxes[:, 2:]
-        # is the size (hits and score unused). Ended targets wait in their own book to be revived; there age counts
-        # the frames since they ended.
-        self.book = TrackBook(KalmanBank(self.model), together=np.int64)
-        self.ended = TrackBook(KalmanBank(self.model))
+        # The targets: streak counts frames in a row with a measurement, together frames in one blob, last_box[:, 2:]
+        # is the size (hits unused). Ended targets wait in a table of their own to be revived; there age counts the
+        # frames since they ended.
+        self.tracks = TrackTable(KalmanBank(self.model), state=np.int8, last_box=(np.float64, (4,)), together=np.int64)
+        self.ended = TrackTable(KalmanBank(self.model), state=np.int8, last_box=(np.float64, (4,)))
         self.gate = chi2_gate(2, p["gate_probability"])
         self.last = {"situations": [], "beta": np.zeros((0, 1)), "gated": np.zeros((0, 0), bool),
                      "ids": np.zeros(0, np.int64), "centres": np.zeros((0, 2)), "S": np.zeros((0, 2, 2))}
@@ -241,12 +229,13 @@ class Jpda(Tracker):
     # -------------------------------------------------------------- one frame
 
     def update(self, obs) -> Tracks:
-        p, book = self.params, self.book
+        p, tracks = self.params, self.tracks
         dets = detections(obs)
         dets = dets[dets[:, 4] >= p["min_confidence"]]
         z = dets[:, :2] + dets[:, 2:4] / 2
-        book.kf.predict()
-        self.ended.predict()
+        tracks.kf.predict()
+        self.ended.kf.predict()
+        self.ended.tick()
         beta, gated, g = self._associate(z)
         situ, unexplained = situations(beta[:, 1:].T)
         if p["situations"] and p["early_duplicates"] and len(z) and \
@@ -257,8 +246,8 @@ class Jpda(Tracker):
             self._apart_is_not_merged(situ, _most_probable(beta))
         if p["situations"]:
             self._separate(situ, beta, g)
-        kf = book.kf
-        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": book.ids.copy(),
+        kf = tracks.kf
+        self.last = {"situations": list(situ), "beta": beta, "gated": gated, "ids": tracks.ids.copy(),
                      "centres": kf.measurement(), "S": kf.innovation_covariance()}
         self._jpda_update(beta, z)
         best = _most_probable(beta)
@@ -277,35 +266,35 @@ class Jpda(Tracker):
         kf.P[occluded, :2, 2:] = kf.P[occluded, 2:, :2] = 0.0
         hidden = self._surplus(occluded, best[occluded], dets) if p["blob_report"] == "size" else occluded[:0]
         sized = np.flatnonzero((kind == NORMAL) | (kind == SEPARATED))
-        book.boxes[sized] = dets[best[sized], :4]
-        book.misses = np.where(kind == VANISHED, book.misses + 1, 0)
-        book.streak = np.where(book.misses == 0, book.streak + 1, 0)
+        tracks.last_box[sized] = dets[best[sized], :4]
+        tracks.misses = np.where(kind == VANISHED, tracks.misses + 1, 0)
+        tracks.streak = np.where(tracks.misses == 0, tracks.streak + 1, 0)
         own = (kind == NORMAL) | (kind == SEPARATED) | (kind == SPLIT)  # a miss says nothing either way
-        book.together = np.where(own, 0, book.together + (kind == OCCLUDED))
-        book.age += 1
-        hidden_ids = book.ids[hidden]
+        tracks.together = np.where(own, 0, tracks.together + (kind == OCCLUDED))
+        tracks.age += 1
+        hidden_ids = tracks.ids[hidden]
         if p["situations"]:
             self._drop_duplicates(situ, best)
-        book.move(book.misses >= p["vanish_frames"], self.ended, age=0)  # vanished: ended, for the revival pool
+        tracks.move(tracks.misses >= p["vanish_frames"], self.ended, age=0)  # vanished: ended, for the revival pool
         fresh = self._revive(z, dets, unexplained) if p["situations"] else unexplained
-        book.add(dets[fresh, :4], np.zeros(len(fresh)), z[fresh])  # new targets at rest (section 5, 2)
-        self.last["situations"] += [REVIVED] * (len(book) - len(situ) - len(fresh)) + [NEW] * len(fresh)
-        book.state[book.streak >= p["min_hits"]] = CONFIRMED  # once: a confirmed target stays so through its misses
-        seen = (book.state == CONFIRMED) & ((book.misses == 0) | p["coast"])
-        seen[np.isin(book.ids, hidden_ids)] = False
-        size = book.boxes[seen, 2:]
-        return Tracks.of(book.ids[seen], np.c_[kf.x[seen, :2] - size / 2, size])
+        tracks.add(len(fresh), z[fresh], hits=1, streak=1, last_box=dets[fresh, :4])  # new targets at rest (section 5, 2)
+        self.last["situations"] += [REVIVED] * (len(tracks) - len(situ) - len(fresh)) + [NEW] * len(fresh)
+        tracks.state[tracks.streak >= p["min_hits"]] = CONFIRMED  # once: a confirmed target stays so through its misses
+        seen = (tracks.state == CONFIRMED) & ((tracks.misses == 0) | p["coast"])
+        seen[np.isin(tracks.ids, hidden_ids)] = False
+        size = tracks.last_box[seen, 2:]
+        return Tracks.of(tracks.ids[seen], np.c_[kf.x[seen, :2] - size / 2, size])
 
     def _associate(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """beta (targets, 1 + measurements) cluster by cluster, and the validation (gate) matrix."""
-        p, n, m = self.params, len(self.book), len(z)
+        p, n, m = self.params, len(self.tracks), len(z)
         beta = np.zeros((n, m + 1))
         beta[:, 0] = 1.0
         if not n or not m:
             return beta, np.zeros((n, m), bool), np.zeros((n, m))
-        d2 = self.book.kf.mahalanobis(z)
+        d2 = self.tracks.kf.mahalanobis(z)
         gated = d2 <= self.gate
-        det_s = np.linalg.det(self.book.kf.innovation_covariance())
+        det_s = np.linalg.det(self.tracks.kf.innovation_covariance())
         g = np.where(gated, np.exp(-0.5 * d2) / (2 * np.pi * np.sqrt(det_s))[:, None], 0.0)
         t_label, z_label = clusters(gated)
         has = gated.any(axis=1)
@@ -327,7 +316,7 @@ class Jpda(Tracker):
         occluded = np.flatnonzero(np.array(situ, dtype=object) == OCCLUDED)
         if len(occluded) < 2:
             return
-        centre, half = self.book.kf.x[occluded, :2], self.book.boxes[occluded, 2:] / 2
+        centre, half = self.tracks.kf.x[occluded, :2], self.tracks.last_box[occluded, 2:] / 2
         apart = (np.abs(centre[:, None] - centre[None]) >= half[:, None] + half[None]).any(axis=2)
         touching = (~apart & (best[occluded][:, None] == best[occluded][None])).sum(axis=1) > 1  # itself too
         for t in occluded[~touching]:
@@ -337,7 +326,7 @@ class Jpda(Tracker):
         """Targets that shared a blob last frame and now see several measurements take one each, from the most
         probable joint event, instead of the soft JPDA mixture that would hold them together at the blob (the
         paper's split rule is meant for fragments of one target; it does not say how merged targets come apart)."""
-        rows = np.flatnonzero((self.book.together > 0) & (np.array(situ, dtype=object) == SPLIT))
+        rows = np.flatnonzero((self.tracks.together > 0) & (np.array(situ, dtype=object) == SPLIT))
         if len(rows) < 2:
             return
         cols = np.flatnonzero(beta[rows, 1:].sum(axis=0) > 0)
@@ -358,7 +347,7 @@ class Jpda(Tracker):
 
     def _jpda_update(self, beta: np.ndarray, z: np.ndarray) -> None:
         """Eq. 10-12 for every target at once: the beta-weighted innovation, and the covariance with its spread."""
-        kf = self.book.kf
+        kf = self.tracks.kf
         if not len(kf) or not len(z):
             return
         H, R, x, P = self.model.H, self.model.R, kf.x, kf.P
@@ -375,7 +364,7 @@ class Jpda(Tracker):
     def _by_blob(self, occluded: np.ndarray, blob: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Occluded targets (rows) and their blobs (measurements) ordered by blob, then eldest, then lowest id, the
         index of each blob's first, and each target's rank in its blob (0 the eldest)."""
-        order = np.lexsort((self.book.ids[occluded], -self.book.age[occluded], blob))
+        order = np.lexsort((self.tracks.ids[occluded], -self.tracks.age[occluded], blob))
         blob = blob[order]
         starts = np.flatnonzero(np.r_[True, blob[1:] != blob[:-1]])
         rank = np.arange(len(blob)) - np.repeat(starts, np.diff(np.r_[starts, len(blob)]))
@@ -390,14 +379,14 @@ class Jpda(Tracker):
         if len(occluded) < 2:
             return False
         occluded, _, _, rank = self._by_blob(occluded, best[occluded])
-        p, book = self.params, self.book
-        duplicate = book.age[occluded] < p["vanish_frames"]
+        p, tracks = self.params, self.tracks
+        duplicate = tracks.age[occluded] < p["vanish_frames"]
         if not newborn_only:
-            duplicate |= book.together[occluded] >= p["merge_frames"]
+            duplicate |= tracks.together[occluded] >= p["merge_frames"]
         dropped = duplicate & (rank > 0)  # the elder of each blob stays
-        keep = np.ones(len(book), bool)
+        keep = np.ones(len(tracks), bool)
         keep[occluded[dropped]] = False
-        book.keep(keep)
+        tracks.keep(keep)
         return bool(dropped.any())
 
     def _surplus(self, occluded: np.ndarray, blob: np.ndarray, dets: np.ndarray) -> np.ndarray:
@@ -407,7 +396,7 @@ class Jpda(Tracker):
             return occluded
         occluded, blob, starts, rank = self._by_blob(occluded, blob)
         members = np.diff(np.r_[starts, len(occluded)])
-        mean_area = np.add.reduceat(self.book.boxes[occluded, 2:].prod(axis=1), starts) / members
+        mean_area = np.add.reduceat(self.tracks.last_box[occluded, 2:].prod(axis=1), starts) / members
         room = np.maximum(1, np.floor(dets[blob[starts], 2:4].prod(axis=1) / np.maximum(mean_area, 1e-9) + 0.5))
         return occluded[rank >= np.repeat(room, members)]
 
@@ -422,8 +411,8 @@ class Jpda(Tracker):
         unique = gated & (gated.sum(axis=0) == 1)[None, :] & (gated.sum(axis=1) == 1)[:, None]
         rows, cols = np.nonzero(unique)
         e.kf.update(rows, z[unexplained[cols]])
-        e.move(rows, self.book, misses=0, streak=1, age=self.params["vanish_frames"],
-               boxes=dets[unexplained[cols], :4])
+        e.move(rows, self.tracks, misses=0, streak=1, age=self.params["vanish_frames"],
+               last_box=dets[unexplained[cols], :4])
         return np.setdiff1d(unexplained, unexplained[cols])
 
     def debug(self) -> list[dict]:
@@ -438,7 +427,6 @@ class Jpda(Tracker):
         return out
 
 
-@register
 class JpdaExact(Jpda):
     """Traditional JPDA, as the paper's baseline: the same filter, but every joint event of a cluster is enumerated
     (exponential in the cluster size), within a budget: a cluster of more than max_events joint events (counted as

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Param, Tracker, Tracks, detections, register
-from .management import BASES, FEATURES, SORT_RULES, Candidates, decisions
+from .base import Param, Tracker, Tracks, detections
+from .parts.management import BASES, FEATURES, SORT_RULES, Candidates, decisions
 
 SHIPPED_POLICY = Path(__file__).with_name("data") / "policy_sort.npz"
 
@@ -46,7 +46,6 @@ def save_policy(path: str | Path, weights: np.ndarray, **about: str) -> None:
             archive.writestr(zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0)), member.getvalue())
 
 
-@register
 class Learned(Tracker):
     """Track management learned from the reward: each frame the base's association (SORT's, or ByteTrack's with its
     low-confidence round) proposes candidates, and a linear policy over their features (`management.FEATURES`)

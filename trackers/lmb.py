@@ -7,12 +7,11 @@ import math
 
 import numpy as np
 
-from . import gaussian_mixture as gm
-from . import reid
-from .assignment import chi2_gate, murty
-from .base import Param, Tracker, Tracks, covariance_ellipse, detections, frame_of, register
-from .camera_motion import METHODS, CameraMotion, warp_boxes, warp_centres
-from .jpda import clusters
+from .base import Param, Tracker, Tracks, covariance_ellipse, detections, frame_of
+from .parts import gaussian_mixture as gm
+from .parts import reid
+from .parts.assignment import chi2_gate, clusters, murty
+from .parts.camera_motion import METHODS, CameraMotion, warp_boxes, warp_centres
 
 EPS = 1e-12
 ENUMERATE_UP_TO = 4096  # groups with at most this many candidate hypotheses (an upper bound) are enumerated
@@ -158,7 +157,6 @@ class _Mixture:
         return np.searchsorted(self.track, np.arange(len(self.r)))
 
 
-@register
 class LabelledMultiBernoulli(Tracker):
     """Labelled multi-Bernoulli filter (Reuter, Vo, Vo, Dietmayer 2014) as Jiang and Yang use it. Each track is a
     Bernoulli with existence probability r and a Gaussian mixture over (x, y, w, h, vx, vy, vw, vh). Prediction
@@ -209,7 +207,8 @@ class LabelledMultiBernoulli(Tracker):
         "low_confidence": Param(0.5, None, "the confidence that use_low_confidence=false cuts at"),
         "reid": Param(True, None, "re-identification from a pool of LOMO features (reads the frame)"),
         "cmc": Param("none", METHODS, "camera-motion compensation from the frame (beyond the paper; see "
-                                      "camera_motion.py): the predictions and last frame's births moved with the image"),
+                                      "parts/camera_motion.py): the predictions and last frame's births moved with "
+                                      "the image"),
         "reid_confidence": Param(0.7, None, "least confidence of a detection whose feature enters the pool",
                                  (0.3, 0.95), needs={"reid": True}),
         "reid_threshold": Param(5.0, "(0, inf)", "largest XQDA distance of a re-identification", (1.0, 25.0, "log"),

@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assignment import corner_iou, lapjv
-from .base import Param, Tracker, Tracks, detections, register
-from .kalman import KalmanBank, box_model, stop_shrinking_to_nothing
-from .sort import associate, state_to_corners, without
+from .base import Param, Tracker, Tracks, detections
+from .parts.boxes import state_to_corners
+from .parts.kalman import KalmanBank, box_model, stop_shrinking_to_nothing
+from .parts.rounds import associate, rematch, without
+from .parts.track_table import TrackTable
 
 NONE = -(2**62)  # the age of an empty slot in a track's recent observations
 NO_BOX = np.full(5, -1.0)  # the reference's placeholder for "no observation" (x1, y1, x2, y2, confidence)
 
 
-@register
 class OcSort(Tracker):
     """SORT's Kalman boxes with three observation-centric changes. Momentum (OCM): the association cost adds to
     IoU how well each detection's direction from the track's observation delta_t frames back agrees with the
@@ -42,26 +42,16 @@ class OcSort(Tracker):
 
     def reset(self, info=None):
         k = self.params["delta_t"]
-        self.kf = KalmanBank(box_model())
-        self.ids = np.zeros(0, np.int64)
-        self.counts = np.zeros((0, 4), np.int64)      # hit streak, hits, age, frames since the last match
-        self.last = np.zeros((0, 5))                   # last observation (x1, y1, x2, y2, confidence), or NO_BOX
-        self.recent_age = np.zeros((0, k), np.int64)   # ages of the last delta_t observations, oldest first
-        self.recent = np.zeros((0, k, 5))              # and those observations
-        self.velocity = np.zeros((0, 2))               # unit direction (dy, dx) between observations
-        self.observed = np.zeros(0, bool)              # the filter's last update had a measurement
-        self.frozen = np.zeros(0, bool)                # a filter state was saved at the first missed frame
-        self.saved_x, self.saved_P = np.zeros((0, 7)), np.zeros((0, 7, 7))
-        self.last_z = np.zeros((0, 4))                 # the filter's last measurement (cx, cy, s, r), real or virtual
-        self.next_id, self.frame = 1, 0
-
-    def _keep(self, mask: np.ndarray) -> None:
-        if mask.all():
-            return
-        self.kf.keep(mask)
-        for name in ("ids", "counts", "last", "recent_age", "recent", "velocity", "observed", "frozen", "saved_x",
-                     "saved_P", "last_z"):
-            setattr(self, name, getattr(self, name)[mask])
+        self.tracks = TrackTable(
+            KalmanBank(box_model()),
+            last=(np.float64, (5,)),           # last observation (x1, y1, x2, y2, confidence), or NO_BOX
+            recent_age=(np.int64, (k,)),       # ages of the last delta_t observations, oldest first
+            recent=(np.float64, (k, 5)),       # and those observations
+            velocity=(np.float64, (2,)),       # unit direction (dy, dx) between observations
+            observed=bool,                     # the filter's last update had a measurement
+            frozen=bool,                       # a filter state was saved at the first missed frame
+            saved_x=(np.float64, (7,)), saved_P=(np.float64, (7, 7)),
+            last_z=(np.float64, (4,)))         # the filter's last measurement (cx, cy, s, r), real or virtual
 
     def update(self, obs) -> Tracks:
         p = self.params
@@ -70,19 +60,17 @@ class OcSort(Tracker):
         score = dets[:, 4]
         high = dets[score > p["det_thresh"]]
         low = dets[(score > 0.1) & (score < p["det_thresh"])]
-        self.frame += 1
-        stop_shrinking_to_nothing(self.kf)
-        self.kf.predict()
-        self.counts[:, 2] += 1
-        self.counts[self.counts[:, 3] > 0, 0] = 0   # a streak ends with a miss
-        self.counts[:, 3] += 1
-        predicted = state_to_corners(self.kf.x)
+        tracks = self.tracks
+        stop_shrinking_to_nothing(tracks.kf)
+        tracks.kf.predict()
+        tracks.tick()
+        predicted = state_to_corners(tracks.kf.x)
         defined = ~np.isnan(predicted).any(axis=1)
-        self._keep(defined)
+        tracks.keep(defined)
         predicted = predicted[defined]
         previous = self._previous_observations()
 
-        bonus = p["inertia"] * direction_agreement(high, previous, self.velocity).T * high[:, 4:5]
+        bonus = p["inertia"] * direction_agreement(high, previous, tracks.velocity).T * high[:, 4:5]
         bonus[:, previous[:, 4] < 0] = 0.0  # no direction from a track never observed
         matched, left_dets, left_tracks = associate(high[:, :4], predicted, p["iou_threshold"], bonus)
         pairs = [(high, matched[:, 0], matched[:, 1])]
@@ -93,7 +81,7 @@ class OcSort(Tracker):
                 pairs.append((low, d, left_tracks[t]))
                 left_tracks = np.sort(left_tracks[without(len(left_tracks), t)])
         if len(left_dets) and len(left_tracks):
-            found = rematch(high[left_dets], self.last[left_tracks], p["iou_threshold"])
+            found = rematch(high[left_dets], tracks.last[left_tracks], p["iou_threshold"])
             if found is not None:
                 d, t = found
                 pairs.append((high, left_dets[d], left_tracks[t]))
@@ -104,22 +92,21 @@ class OcSort(Tracker):
         self._miss(left_tracks)
         self._start(high[left_dets])
 
-        streak, misses = self.counts[:, 0], self.counts[:, 3]
-        report = (misses < 1) & ((streak >= p["min_hits"]) | (self.frame <= p["min_hits"]))
-        box = np.where((self.last.sum(axis=1) < 0)[:, None], state_to_corners(self.kf.x), self.last[:, :4])
+        report = (tracks.misses < 1) & ((tracks.streak >= p["min_hits"]) | (tracks.frame <= p["min_hits"]))
+        box = np.where((tracks.last.sum(axis=1) < 0)[:, None], state_to_corners(tracks.kf.x), tracks.last[:, :4])
         box = box[report]
-        out = Tracks.of(self.ids[report], np.concatenate([box[:, :2], box[:, 2:] - box[:, :2]], axis=1))
-        self._keep(misses <= p["max_age"])
+        out = Tracks.of(tracks.ids[report], np.concatenate([box[:, :2], box[:, 2:] - box[:, :2]], axis=1))
+        tracks.keep(tracks.misses <= p["max_age"])
         return out
 
     def _previous_observations(self) -> np.ndarray:
         """Per track, the observation delta_t frames back, or the nearest after it, or else the latest (the
         reference's k_previous_obs); NO_BOX for a track never observed."""
-        k = self.params["delta_t"]
-        within = self.recent_age >= (self.counts[:, 2:3] - k)
+        k, tracks = self.params["delta_t"], self.tracks
+        within = tracks.recent_age >= (tracks.age[:, None] - k)
         slot = np.where(within.any(axis=1), within.argmax(axis=1), k - 1)
-        out = self.recent[np.arange(len(slot)), slot]
-        out[self.recent_age[:, -1] == NONE] = NO_BOX
+        out = tracks.recent[np.arange(len(slot)), slot]
+        out[tracks.recent_age[:, -1] == NONE] = NO_BOX
         return out
 
     def _observe(self, t: np.ndarray, boxes: np.ndarray, previous: np.ndarray) -> None:
@@ -127,32 +114,33 @@ class OcSort(Tracker):
         reference's KalmanBoxTracker.update, the filter re-updated along the gap first where it was frozen."""
         if not len(t):
             return
-        had = self.last[t].sum(axis=1) >= 0  # the reference's test for "observed before" (a box's sum, as it is)
-        self.velocity[t[had]] = unit_direction(previous[had], boxes[had])
-        self.last[t] = boxes
-        self.recent_age[t] = np.concatenate([self.recent_age[t, 1:], self.counts[t, 2:3]], axis=1)
-        self.recent[t] = np.concatenate([self.recent[t, 1:], boxes[:, None]], axis=1)
+        tracks = self.tracks
+        had = tracks.last[t].sum(axis=1) >= 0  # the reference's test for "observed before" (a box's sum, as it is)
+        tracks.velocity[t[had]] = unit_direction(previous[had], boxes[had])
+        tracks.last[t] = boxes
+        tracks.recent_age[t] = np.concatenate([tracks.recent_age[t, 1:], tracks.age[t, None]], axis=1)
+        tracks.recent[t] = np.concatenate([tracks.recent[t, 1:], boxes[:, None]], axis=1)
         z = corners_to_z(boxes[:, :4])
-        rewind = ~self.observed[t] & self.frozen[t]
+        rewind = ~tracks.observed[t] & tracks.frozen[t]
         virtual = self._reupdate(t[rewind], z[rewind]) if rewind.any() else None
-        self.last_z[t] = z
+        tracks.last_z[t] = z
         if virtual is not None:
-            self.last_z[t[rewind]] = virtual
-        self.observed[t], self.frozen[t] = True, False
-        self.counts[t, 3] = 0
-        self.counts[t, :2] += 1
-        self.kf.update(t, z)
+            tracks.last_z[t[rewind]] = virtual
+        tracks.observed[t], tracks.frozen[t] = True, False
+        tracks.matched(t)
+        tracks.kf.update(t, z)
 
     def _reupdate(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
         """ORU: rewind tracks t to their state at the first missed frame and update them with virtual measurements
         on the straight line from the last measurement to z, one per frame of the gap, predicting between (the
         reference's unfreeze). Returns the last virtual measurements."""
-        gap = self.counts[t, 3]
-        x1, y1, w1, h1 = z_to_xywh(self.last_z[t])
+        tracks = self.tracks
+        gap = tracks.misses[t]
+        x1, y1, w1, h1 = z_to_xywh(tracks.last_z[t])
         x2, y2, w2, h2 = z_to_xywh(z)
         step = [(b - a) / gap for a, b in ((x1, x2), (y1, y2), (w1, w2), (h1, h2))]
-        bank = KalmanBank(self.kf.m)
-        bank.x, bank.P = self.saved_x[t].copy(), self.saved_P[t].copy()
+        bank = KalmanBank(tracks.kf.m)
+        bank.x, bank.P = tracks.saved_x[t].copy(), tracks.saved_P[t].copy()
         virtual = np.zeros((len(t), 4))
         for i in range(int(gap.max())):
             rows = np.flatnonzero(gap > i)
@@ -162,37 +150,19 @@ class OcSort(Tracker):
             more = gap > i + 1
             x_next, P_next = bank.x @ bank.m.F.T, bank.m.F @ bank.P @ bank.m.F.T + bank.m.Q
             bank.x[more], bank.P[more] = x_next[more], P_next[more]
-        self.kf.x[t], self.kf.P[t] = bank.x, bank.P
+        tracks.kf.x[t], tracks.kf.P[t] = bank.x, bank.P
         return virtual
 
     def _miss(self, t: np.ndarray) -> None:
         """Tracks t unmatched: the first miss after a measurement saves the filter's state for a later re-update."""
-        first = t[self.observed[t]]
-        self.saved_x[first], self.saved_P[first] = self.kf.x[first], self.kf.P[first]
-        self.frozen[first], self.observed[t] = True, False
+        tracks = self.tracks
+        first = t[tracks.observed[t]]
+        tracks.saved_x[first], tracks.saved_P[first] = tracks.kf.x[first], tracks.kf.P[first]
+        tracks.frozen[first], tracks.observed[t] = True, False
 
     def _start(self, boxes: np.ndarray) -> None:
-        n, k = len(boxes), self.params["delta_t"]
-        self.kf.add(corners_to_z(boxes[:, :4]))
-        grow = {"ids": np.arange(self.next_id, self.next_id + n), "counts": np.zeros((n, 4), np.int64),
-                "last": np.tile(NO_BOX, (n, 1)), "recent_age": np.full((n, k), NONE),
-                "recent": np.zeros((n, k, 5)), "velocity": np.zeros((n, 2)), "observed": np.zeros(n, bool),
-                "frozen": np.zeros(n, bool), "saved_x": np.zeros((n, 7)), "saved_P": np.zeros((n, 7, 7)),
-                "last_z": np.zeros((n, 4))}
-        for name, new in grow.items():
-            setattr(self, name, np.concatenate([getattr(self, name), new]))
-        self.next_id += n
-
-
-def rematch(dets: np.ndarray, boxes: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """A second-round matching by IoU alone (OCR, BYTE): (detection rows, box rows) of the assignment's pairs at or
-    over the threshold; None where no IoU exceeds it (the reference then leaves its lists as they are)."""
-    iou = corner_iou(dets[:, :4], boxes[:, :4])
-    if iou.max() <= threshold:
-        return None
-    pairs = lapjv(-iou)[0]
-    pairs = pairs[iou[pairs[:, 0], pairs[:, 1]] >= threshold]
-    return pairs[:, 0], pairs[:, 1]
+        """Tracks born from detections (x1, y1, x2, y2, confidence): never observed yet, as the reference's."""
+        self.tracks.add(len(boxes), corners_to_z(boxes[:, :4]), last=NO_BOX, recent_age=NONE)
 
 
 def unit_direction(a: np.ndarray, b: np.ndarray) -> np.ndarray:

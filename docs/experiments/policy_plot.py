@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from mtt_sim.trackers.learned import SHIPPED_POLICY, load_policy
-from mtt_sim.trackers.management import FEATURES, SORT_RULES
+from mtt_sim.trackers.parts.management import FEATURES, SORT_RULES
 
 TYPICAL = {"confidence": 0.8, "match_iou": 0.7, "height": 0.15, "aspect": 0.1, "growth": 0.0, "speed": 0.05,
            "overlap": 0.0, "border": 1.0}

@@ -10,7 +10,7 @@ import time
 
 import gymnasium as gym
 import numpy as np
-from mtt_sim.trackers.management import SORT_RULES, decisions
+from mtt_sim.trackers.parts.management import SORT_RULES, decisions
 from stable_baselines3 import PPO
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import SubprocVecEnv

@@ -56,7 +56,7 @@ def add(subparsers) -> None:
 
 
 def base_name(text: str) -> str:
-    from mtt_sim.trackers.management import BASES
+    from mtt_sim.trackers.parts.management import BASES
 
     if text not in BASES:
         raise argparse.ArgumentTypeError(f"{text!r}: allowed: {', '.join(BASES)}")

@@ -25,7 +25,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    from mtt_sim.trackers import reid
+    from mtt_sim.trackers.parts import reid
 
     if is_sequence(args.scenario):
         raise UsageError("--scenario", f"{args.scenario!r} is a sequence folder: crops are rendered from a simulated "

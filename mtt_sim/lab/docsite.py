@@ -31,6 +31,7 @@ DOCS = ROOT / "docs"  # the site's pages, images and notebooks
 NAV = [("Home", "index.md"),
        ("The Gym loop", "gym.md"),
        ("Trackers", [("Trackers", "trackers.md"), ("One page each", "trackers/"),
+                     ("Trackers from parts", "trackers_from_parts.md"),
                      ("Peers: Roboflow's trackers", "peers.md"),
                      ("Camera-motion compensation", "camera_motion.md")]),
        ("Scenarios", [("Scenarios", "scenarios.md"), ("One page each", "scenarios/")]),

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from mtt_sim.trackers import reid
+from mtt_sim.trackers.parts import reid
 
 from mtt_sim.env import TrackingEnv
 from mtt_sim.lab.episode import Episode

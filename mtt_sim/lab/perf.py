@@ -323,7 +323,7 @@ def measure_baselines(repeats: int = 5, frames: int = 300, workloads=BASELINE_WO
     workload (a scenario or sequence folder, and its config), beside Roboflow's same tracker (its update() on
     supervision Detections built beforehand) where its package is installed (the [peers] extra), in the same run."""
     try:
-        package = trackers.roboflow.roboflow_package()
+        package = trackers.adapters.roboflow.roboflow_package()
         from supervision import Detections
     except ImportError:
         package = None
@@ -337,7 +337,7 @@ def measure_baselines(repeats: int = 5, frames: int = 300, workloads=BASELINE_WO
                 peer = float("nan")
                 if package is not None:
                     model = getattr(package, theirs)()
-                    dets = [trackers.roboflow.as_detections(Detections, trackers.base.detections(o)) for o in rec[1]]
+                    dets = [trackers.adapters.roboflow.as_detections(Detections, trackers.base.detections(o)) for o in rec[1]]
                     peer = n / _time(lambda: [model.update(d) for d in dets])
                 runs.append((1e3 / _ms_per_frame(ours, rec), peer))
             fps, peer = (statistics.median(r[i] for r in runs) for i in range(2))

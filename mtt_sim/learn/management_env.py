@@ -1,7 +1,7 @@
 """TrackManagementEnv: track management as a Gymnasium decision process over the tracking env.
 
 Each frame a base tracker's association (`base="sort"`, or `"bytetrack"`) proposes candidate tracks
-(`trackers.management.Candidates`); the agent decides for each candidate whether to report it this frame and whether
+(`trackers.parts.management.Candidates`); the agent decides for each candidate whether to report it this frame and whether
 to keep it alive. The reward is the tracking env's reward for the reported tracks, unchanged (by default TP - FP - IDSW: the return over the ground-truth count is MOTA).
 """
 
@@ -16,14 +16,14 @@ from gymnasium import spaces
 
 from mtt_sim.env import TrackingEnv
 from mtt_sim.trackers.base import detections
-from mtt_sim.trackers.management import BASES, FEATURES, Candidates
+from mtt_sim.trackers.parts.management import BASES, FEATURES, Candidates
 
 DECISION_COLOURS = {"report": (40, 200, 40), "keep": (230, 200, 40), "drop": (220, 50, 50)}
 
 
 class TrackManagementEnv(gym.Env):
     """**Observation** ``Dict(features=Box(float32, (max_candidates, F)), mask=MultiBinary(max_candidates))``: one row
-    of `trackers.management.FEATURES` per candidate track (F of them), zero rows after the candidates, whose rows
+    of `trackers.parts.management.FEATURES` per candidate track (F of them), zero rows after the candidates, whose rows
     the mask marks. **Action** ``MultiBinary(2 * max_candidates)``: per row, report it this frame, keep it alive, as
     the flattened ``(max_candidates, 2)`` array (flat for learners such as Stable-Baselines3; that 2-D array is taken
     too). Rows past the mask are ignored. **Reward** the tracking env's reward for the reported tracks. Takes anything

@@ -27,7 +27,7 @@ from mtt_sim.lab.export import export_episode
 from mtt_sim.lab.journal import Journal
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.trackers.learned import save_policy
-from mtt_sim.trackers.management import SORT_RULES
+from mtt_sim.trackers.parts.management import SORT_RULES
 
 FAILED = 1e9  # what CMA-ES minimises for a policy whose episode failed: worse than any score
 

@@ -1,4 +1,5 @@
-"""Association: IoU, chi-square gates, gated Hungarian assignment and Murty's k-best assignments (scipy)."""
+"""Association: IoU, chi-square gates, clusters of gated pairs, gated Hungarian assignment and Murty's k-best
+assignments (scipy)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ import heapq
 import lap
 import numpy as np
 from scipy.optimize import linear_sum_assignment
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.special import chdtri
 
 
@@ -22,6 +25,14 @@ def corner_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     wh = w * h
     area_a, area_b = (a[:, 2] - a[:, 0]) * (a[:, 3] - a[:, 1]), (b[:, 2] - b[:, 0]) * (b[:, 3] - b[:, 1])
     return wh / (area_a[:, None] + area_b - wh)
+
+
+def paired_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """IoU of corner boxes a[i] and b[i], row by row."""
+    wh = np.clip(np.minimum(a[:, 2:], b[:, 2:]) - np.maximum(a[:, :2], b[:, :2]), 0, None)
+    inter = wh[:, 0] * wh[:, 1]
+    area = lambda c: (c[:, 2] - c[:, 0]) * (c[:, 3] - c[:, 1])
+    return inter / (area(a) + area(b) - inter)
 
 
 def plus_one_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -56,6 +67,15 @@ def lapjv(cost: np.ndarray, limit: float = np.inf) -> tuple[np.ndarray, np.ndarr
 def chi2_gate(dim: int, probability: float = 0.99) -> float:
     """The squared-Mahalanobis gate that a true measurement passes with `probability`."""
     return float(chdtri(dim, 1.0 - probability))  # chi2.ppf(probability, dim), without importing scipy.stats
+
+
+def clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cluster labels of targets (rows) and measurements (columns) linked by gated pairs (connected components)."""
+    n, m = gated.shape
+    rows, cols = np.nonzero(gated)
+    graph = coo_matrix((np.ones(len(rows)), (rows, n + cols)), shape=(n + m, n + m))
+    labels = connected_components(graph, directed=False)[1]
+    return labels[:n], labels[n:]
 
 
 def assign(cost: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

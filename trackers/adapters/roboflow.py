@@ -16,8 +16,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .base import Param, Tracker, Tracks, detections, frame_of, register
-from .external import _track_rows, to_tracks
+from ..base import Param, Tracker, Tracks, detections, frame_of
+from .rows import to_tracks, track_rows
 
 
 class SupervisionTracker(Tracker):
@@ -68,7 +68,7 @@ def tracked(out, what: str) -> Tracks:
     if ids is None or getattr(out, "xyxy", None) is None:
         raise ValueError(f"{what} must return Detections with xyxy and tracker_id, got {type(out).__name__}")
     rows = np.c_[np.asarray(out.xyxy, float).reshape(-1, 4), np.asarray(ids, float).reshape(-1)]
-    return to_tracks(_track_rows(rows[~(rows[:, 4] < 0)]), "xyxy")
+    return to_tracks(track_rows(rows[~(rows[:, 4] < 0)]), "xyxy")
 
 
 def roboflow_package():
@@ -130,14 +130,12 @@ def _without(params: dict[str, Param], *keys: str) -> dict[str, Param]:
     return {k: v for k, v in params.items() if k not in keys}
 
 
-@register
 class RoboflowSort(RoboflowTracker):
     name, roboflow_class = "roboflow:sort", "SORTTracker"
     description = "Roboflow trackers' SORTTracker (needs the [peers] extra)"
     parameters = _lifecycle(0.25, 3, 0.3)
 
 
-@register
 class RoboflowByteTrack(RoboflowTracker):
     name, roboflow_class = "roboflow:bytetrack", "ByteTrackTracker"
     description = "Roboflow trackers' ByteTrackTracker (needs the [peers] extra)"
@@ -145,7 +143,6 @@ class RoboflowByteTrack(RoboflowTracker):
                   "high_conf_det_threshold": Param(0.6, "[0, 1]", "confidence splitting high from low detections")}
 
 
-@register
 class RoboflowOcSort(RoboflowTracker):
     name, roboflow_class = "roboflow:ocsort", "OCSORTTracker"
     description = "Roboflow trackers' OCSORTTracker (needs the [peers] extra)"
@@ -155,7 +152,6 @@ class RoboflowOcSort(RoboflowTracker):
                   "delta_t": Param(3, "[1, inf)", "frames back to the observation a direction is measured from")}
 
 
-@register
 class RoboflowBotSort(RoboflowTracker):
     name, roboflow_class = "roboflow:botsort", "BoTSORTTracker"
     description = "Roboflow trackers' BoTSORTTracker (needs the [peers] extra; reads the frame with enable_cmc)"

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import Param
+from ..base import Param
 from .near_pairs import near_in_x_and_y
 
 DIM, MEAS = 8, 4

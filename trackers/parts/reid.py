@@ -25,7 +25,7 @@ HSV_BINS, TAU = 8, 0.3
 LEVELS = 3                # pyramid levels (halving each time; a level narrower than a window is skipped)
 _ROWS = sum(((CROP[1] >> k) - WINDOW) // STRIDE + 1 for k in range(LEVELS) if min(CROP) >> k >= WINDOW)
 _DIM = _ROWS * (HSV_BINS ** 3 + 2 * 81)  # windows' rows over the pyramid levels, times the bins of each part
-METRIC_FILE = Path(__file__).with_name("data") / "xqda.npz"
+METRIC_FILE = Path(__file__).parent.parent / "data" / "xqda.npz"
 
 
 def retinex(imgs: np.ndarray, sigmas=(2.0, 8.0)) -> np.ndarray:
