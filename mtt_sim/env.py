@@ -183,8 +183,9 @@ class TrackingEnv(gym.Env):
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self.remember_tracks(ids, boxes)
-        gt_ids, gt_boxes, kept, everyone = self.source.scored_truth(boxes)
-        stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept], everyone)
+        truth = self.source.scored_truth(boxes)
+        kept = truth.scored_tracks
+        stats = self.metrics.update(truth.ids, truth.boxes, ids[kept], boxes[kept], truth.in_view)
         reward = self._reward(stats) if self.scored else 0.0
         self.source.advance()
         self.steps += 1

@@ -1,5 +1,6 @@
 """The package's shape: data flows one way (no module imports one that imports it back, lazy imports included), the
-trackers never import the simulator, no module is over 500 lines, and `import trackers` is not this project."""
+trackers never import the simulator, the recorded source never imports the simulator (their shared types live below
+both), no module is over 500 lines, and `import trackers` is not this project."""
 
 import ast
 import subprocess
@@ -100,6 +101,25 @@ def test_the_trackers_never_import_the_simulator():
         if name.startswith("mtt_sim.trackers"):
             outside = sorted(t for t in targets if not t.startswith("mtt_sim.trackers"))
             assert not outside, f"{name} imports {outside}"
+
+
+def test_the_recorded_source_never_imports_the_simulator():
+    for name, targets in graph().items():
+        if name.startswith("mtt_sim.real"):
+            simulator = sorted(t for t in targets if t == "mtt_sim.sim" or t.startswith("mtt_sim.sim."))
+            assert not simulator, f"{name} imports {simulator}"
+
+
+def test_the_names_that_moved_below_both_sources_keep_their_old_paths_with_a_warning():
+    from mtt_sim.core import settings
+    from mtt_sim.sim import config, truth
+
+    with pytest.warns(DeprecationWarning, match="mtt_sim.core.settings.ConfigError"):
+        assert config.ConfigError is settings.ConfigError
+    with pytest.warns(DeprecationWarning, match="mtt_sim.boxes.occlusion_visibility"):
+        from mtt_sim.sim.truth import occlusion_visibility  # noqa: F401
+    with pytest.raises(AttributeError):
+        truth.no_such_name
 
 
 @pytest.mark.parametrize("name", sorted(modules()))

@@ -21,7 +21,7 @@ from typing import Sequence
 from mtt_sim import sources
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario
-from mtt_sim.sim.config import SensorConfig, table
+from mtt_sim.core.settings import SensorConfig, table
 
 SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
                 "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
