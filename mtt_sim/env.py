@@ -318,9 +318,9 @@ class TrackingEnv(gym.Env):
         tracks = self._last_tracks if self._answered else (np.zeros(0, np.int64), np.zeros((0, 4)))
         img = draw_overlay(frame, truth, dets, *tracks, self._trails, self.render_scale)
         draw_debug(img, debug, self.render_scale)
-        m = self.metrics
+        c = self.metrics.clear
         banner = f"frame {index}" + (f"  {name}" if name else "") + "  " + running_metrics(
-            m.tp, m.fp, m.fn, m.idsw, self._running_idf1())
+            c.tp, c.fp, c.fn, c.idsw, self._running_idf1())
         draw_legend(draw_banner(img, banner))
         if self._viewer:
             self._viewer.show(img)

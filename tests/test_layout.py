@@ -120,6 +120,11 @@ def test_the_names_that_moved_below_both_sources_keep_their_old_paths_with_a_war
         from mtt_sim.sim.truth import occlusion_visibility  # noqa: F401
     with pytest.raises(AttributeError):
         truth.no_such_name
+    from mtt_sim import cli
+    from mtt_sim.metrics import PRINTED
+
+    with pytest.warns(DeprecationWarning, match="mtt_sim.metrics.PRINTED"):
+        assert cli.SUMMARY_KEYS == PRINTED
 
 
 @pytest.mark.parametrize("name", sorted(modules()))
