@@ -1,7 +1,8 @@
 """Box geometry every stage shares (the sensor, calibration, scoring): boxes are x, y, w, h rows.
 
 IoU, union boxes, centres, the id lookup, the thresholded Hungarian matching, the check of one frame's ids and
-boxes, clipping to the image, the pairs that overlap, and the visible fraction of people standing on a ground plane. The bottom layer of the simulator: it imports only numpy and scipy.
+boxes, clipping to the image, the pairs that overlap, and the visible fraction of people standing on a ground plane.
+The bottom layer of both sources: it imports only numpy and scipy.
 """
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ PEOPLE = (1, 2, 7, 8, 12)  # pedestrian, person on vehicle, static person, distr
 VALID_CLASSES = range(1, 14)
 FRAME_RATE = 30.0  # where there is no seqinfo.ini
 REQUIRED_INFO = ("frameRate", "seqLength", "imWidth", "imHeight")  # what a seqinfo.ini must give
-Twin = Callable[[SensorConfig, tuple[int, int], np.random.Generator], object]  # a detector: .detect(truth) -> Detections
+Twin = Callable[[SensorConfig, tuple[int, int], np.random.Generator], object]  # makes a detector: .detect(Truth)
 
 
 @dataclass(frozen=True)
