@@ -8,7 +8,8 @@ from importlib import metadata
 
 from gymnasium.envs.registration import register, registry
 
-from mtt_sim.sim.config import ConfigError, Scenario
+from mtt_sim.core.settings import ConfigError
+from mtt_sim.sim.config import Scenario
 from mtt_sim.sim.scenario import available, load, shipped_names
 
 __version__ = metadata.version("mtt-sim")

@@ -1,7 +1,8 @@
 """Box geometry every stage shares (the sensor, calibration, scoring): boxes are x, y, w, h rows.
 
-IoU, union boxes, centres, the id lookup, the thresholded Hungarian matching and the check of one frame's ids and
-boxes. The bottom layer of the simulator: it imports only numpy and scipy.
+IoU, union boxes, centres, the id lookup, the thresholded Hungarian matching, the check of one frame's ids and
+boxes, clipping to the image, the pairs that overlap, and the visible fraction of people standing on a ground plane.
+The bottom layer of both sources: it imports only numpy and scipy.
 """
 
 from __future__ import annotations
@@ -99,3 +100,50 @@ def check_frame(what: str, ids, boxes, where: str, positive: bool = False) -> tu
     if len(set(ids.tolist())) != len(ids):
         raise ValueError(f"{where}: {what} ids must be unique within a frame")
     return ids.astype(np.int64), boxes
+
+
+def clip_boxes(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Boxes (n, 4) x, y, w, h clipped to the image; fully outside boxes get zero size."""
+    boxes = np.asarray(boxes, np.float64)  # float32 corners would round x + w
+    corners = np.concatenate([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]], axis=1)
+    np.clip(corners, 0, (width, height, width, height), out=corners)
+    corners[:, 2:] -= corners[:, :2]
+    return corners
+
+
+def occlusion_visibility(boxes: np.ndarray, width: int, height: int, grid: tuple[int, int] = (8, 16)) -> np.ndarray:
+    """Visible fraction of each box x, y, w, h of people on a ground plane: a box whose bottom edge is lower stands
+    nearer and hides what it covers, and the image border hides what lies outside. Measured on a grid of points (8
+    across, 16 down) in each box: the share that lies in the image and that no nearer box covers."""
+    n = len(boxes)
+    if not n:
+        return np.zeros(0)
+    u = (np.arange(grid[0]) + 0.5) / grid[0]
+    v = (np.arange(grid[1]) + 0.5) / grid[1]
+    px = (boxes[:, 0, None] + boxes[:, 2, None] * u).repeat(grid[1], axis=1)  # (n, points)
+    py = np.tile(boxes[:, 1, None] + boxes[:, 3, None] * v, grid[0])
+    bottom = boxes[:, 1] + boxes[:, 3]
+    seen = (px >= 0) & (px < width) & (py >= 0) & (py < height)
+    for i, j in zip(*overlapping_pairs(boxes)):  # each pair once: the nearer box hides part of the farther one
+        near, far = (i, j) if bottom[i] > bottom[j] else (j, i)
+        if bottom[near] == bottom[far]:
+            continue
+        b = boxes[near]
+        seen[far] &= ~((px[far] >= b[0]) & (px[far] < b[0] + b[2]) & (py[far] >= b[1]) & (py[far] < b[1] + b[3]))
+    return seen.mean(axis=1)
+
+
+def overlapping_pairs(boxes: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs (i, j), i != j, each pair once, of boxes x, y, w, h that intersect or come within `margin`.
+
+    Sort and sweep along x, then test y on the candidate pairs: O(n log n + pairs) instead of an n x n matrix.
+    """
+    n = len(boxes)
+    order = np.argsort(boxes[:, 0], kind="stable")
+    b = boxes[order]
+    end = np.searchsorted(b[:, 0], b[:, 0] + b[:, 2] + margin, side="left")
+    counts = np.maximum(end - np.arange(n) - 1, 0)
+    k = np.repeat(np.arange(n), counts)
+    l = k + 1 + np.arange(len(k)) - np.repeat(np.cumsum(counts) - counts, counts)
+    ok = (b[k, 1] < b[l, 1] + b[l, 3] + margin) & (b[l, 1] < b[k, 1] + b[k, 3] + margin)
+    return order[k[ok]], order[l[ok]]

@@ -183,8 +183,9 @@ class TrackingEnv(gym.Env):
             raise RuntimeError("step() called on a finished or unreset episode; call reset() first")
         ids, boxes = self.validate_action(action)
         self.remember_tracks(ids, boxes)
-        gt_ids, gt_boxes, kept, everyone = self.source.scored_truth(boxes)
-        stats = self.metrics.update(gt_ids, gt_boxes, ids[kept], boxes[kept], everyone)
+        truth = self.source.scored_truth(boxes)
+        kept = truth.scored_tracks
+        stats = self.metrics.update(truth.ids, truth.boxes, ids[kept], boxes[kept], truth.in_view)
         reward = self._reward(stats) if self.scored else 0.0
         self.source.advance()
         self.steps += 1
@@ -317,9 +318,9 @@ class TrackingEnv(gym.Env):
         tracks = self._last_tracks if self._answered else (np.zeros(0, np.int64), np.zeros((0, 4)))
         img = draw_overlay(frame, truth, dets, *tracks, self._trails, self.render_scale)
         draw_debug(img, debug, self.render_scale)
-        m = self.metrics
+        c = self.metrics.clear
         banner = f"frame {index}" + (f"  {name}" if name else "") + "  " + running_metrics(
-            m.tp, m.fp, m.fn, m.idsw, self._running_idf1())
+            c.tp, c.fp, c.fn, c.idsw, self._running_idf1())
         draw_legend(draw_banner(img, banner))
         if self._viewer:
             self._viewer.show(img)

@@ -13,15 +13,15 @@ from typing import TYPE_CHECKING, Mapping, Protocol
 
 import numpy as np
 
+from mtt_sim.core.frame import Detections, ScoredTruth, Truth
+from mtt_sim.core.settings import ConfigError
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario
-from mtt_sim.sim.config import ConfigError, Scenario
+from mtt_sim.sim.config import Scenario
 
 if TYPE_CHECKING:
     from mtt_sim.real.sequence import Recording, SequenceConfig
     from mtt_sim.sim.scene import Scene
-    from mtt_sim.sim.sensor import Detections
-    from mtt_sim.sim.truth import Truth
 
 
 class Source(Protocol):
@@ -47,9 +47,9 @@ class Source(Protocol):
     def first_targets(self) -> tuple[np.ndarray, np.ndarray]:
         """Ids and boxes of the targets of the first frame, for trackers initialised by hand."""
 
-    def scored_truth(self, track_boxes: np.ndarray) -> tuple:
-        """The current frame's scored ground-truth ids and boxes, which of these tracks are scored (a mask or a
-        slice), and everyone in view (ids, boxes, visibility) for the occlusion windows, or None."""
+    def scored_truth(self, track_boxes: np.ndarray) -> ScoredTruth:
+        """What the current frame's tracks (these boxes) are scored against: the scored targets, which of the tracks
+        are scored, and everyone in view for the occlusion windows (or None)."""
 
     def advance(self) -> None:
         """Move on to the next frame."""
@@ -78,8 +78,9 @@ def open_source(what: str | os.PathLike | Scenario, overrides: Mapping | None = 
     # the sources are imported here, when one is opened: naming one (`resolve`) stays cheap for the command line
     if recorded or (not isinstance(what, Scenario) and is_sequence(what)):
         from mtt_sim.real.sequence import Recording
+        from mtt_sim.sim.sensor import twin_sensor
 
-        recording = Recording(what, benchmark, overrides)
+        recording = Recording(what, benchmark, overrides, twin_sensor)
         if recording.scored and not recording.truth_rows:
             raise ConfigError(f"{Path(what) / 'gt' / 'gt.txt'}: no rows: nothing to score against, and nobody for a "
                               "twin to detect (remove the file to replay the sequence unscored)")

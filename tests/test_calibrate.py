@@ -15,7 +15,7 @@ from mtt_sim.lab.export import export_episode
 from mtt_sim.sim import scenario
 from mtt_sim.sim2real import validate
 from mtt_sim.env import NO_TRACKS
-from mtt_sim.sim.truth import Truth
+from mtt_sim.core.frame import Truth
 
 KNOWN = {"model": "synthetic", "pd": 0.85, "pd_spread": 0.8, "miss_corr": 0.6, "visibility_slope": 3.0, "reference_height": 100.0,
          "min_visibility": 0.0, "box_noise": 0.03, "box_size_noise": 0.03, "box_drift": 0.05, "box_size_drift": 0.1,

@@ -1,6 +1,7 @@
 """The package's shape: data flows one way (no module imports one that imports it back, lazy imports included), the
-trackers never import the simulator, a tracker imports only the base and the parts (never another tracker), no
-module is over 500 lines, and `import trackers` is not this project."""
+trackers never import the simulator, a tracker imports only the base and the parts (never another tracker), the
+recorded source never imports the simulator (their shared types live below both), no module is over 500 lines, and
+`import trackers` is not this project."""
 
 import ast
 import subprocess
@@ -135,6 +136,30 @@ def test_a_tracker_imports_only_the_base_and_the_parts():
     tracker_modules = {cls.__module__ for cls in BUILT_IN}
     assert {"mtt_sim.trackers.sort", "mtt_sim.trackers.adapters.roboflow"} <= tracker_modules
     assert layer_breaks(graph(), tracker_modules) == []
+
+
+def test_the_recorded_source_never_imports_the_simulator():
+    for name, targets in graph().items():
+        if name.startswith("mtt_sim.real"):
+            simulator = sorted(t for t in targets if t == "mtt_sim.sim" or t.startswith("mtt_sim.sim."))
+            assert not simulator, f"{name} imports {simulator}"
+
+
+def test_the_names_that_moved_below_both_sources_keep_their_old_paths_with_a_warning():
+    from mtt_sim.core import settings
+    from mtt_sim.sim import config, truth
+
+    with pytest.warns(DeprecationWarning, match="mtt_sim.core.settings.ConfigError"):
+        assert config.ConfigError is settings.ConfigError
+    with pytest.warns(DeprecationWarning, match="mtt_sim.boxes.occlusion_visibility"):
+        from mtt_sim.sim.truth import occlusion_visibility  # noqa: F401
+    with pytest.raises(AttributeError):
+        truth.no_such_name
+    from mtt_sim import cli
+    from mtt_sim.metrics import PRINTED
+
+    with pytest.warns(DeprecationWarning, match="mtt_sim.metrics.PRINTED"):
+        assert cli.SUMMARY_KEYS == PRINTED
 
 
 @pytest.mark.parametrize("name", sorted(modules()))

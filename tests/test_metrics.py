@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackeval_reference as ref
-from mtt_sim.metrics import EpisodeMetrics, evaluate, gospa
+from mtt_sim.metrics import METRICS, PER_TARGET, SUMMARY_FIELDS, EpisodeMetrics, evaluate, gospa
 
 E = (np.zeros(0, int), np.zeros((0, 4)))
 
@@ -283,3 +283,19 @@ def test_occlusion_windows_need_every_scored_target_among_those_in_view():
     with pytest.raises(ValueError, match=r"frame 0: everyone must be \(ids, boxes, visibility\)"):
         m.update([1], box, [5], box, everyone=(np.array([1]), box))
     assert len(m) == 0 and m.summary()["TP"] == 0   # a rejected frame is not scored
+
+
+def test_every_family_reports_the_fields_it_declares_in_their_order_and_types():
+    m = EpisodeMetrics()
+    boxes = np.array([[0.0, 0, 10, 10], [20, 0, 10, 10]])
+    for _ in range(3):
+        m.update(np.array([1, 2]), boxes, np.array([5]), boxes[:1] + 1, (np.array([1, 2]), boxes, np.array([1.0, 0.0])))
+    for family in m.families:
+        values = family.summary()
+        assert tuple(values) == tuple(f.name for f in family.FIELDS), type(family).__name__
+        assert all(f.value(values[f.name]) == values[f.name] for f in family.FIELDS)
+    summary = m.summary()
+    assert tuple(summary) == METRICS and all(type(summary[f.name]) is f.kind for f in SUMMARY_FIELDS
+                                             if summary[f.name] is not None)
+    assert sorted(m.per_target()[1]) == list(PER_TARGET)
+

@@ -15,7 +15,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 INSTALLED_AS = {"mtt_sim": "mtt_sim", "trackers": "mtt_sim/trackers", "scenarios": "mtt_sim/scenarios"}  # folder: in the wheel
-DATA = {"scenarios": "*.toml", "mtt_sim/sim/detectors": "*.toml", "trackers/data": "*.npz"}  # read by the code at run time
+DATA = {"scenarios": "*.toml", "mtt_sim/core/detectors": "*.toml", "trackers/data": "*.npz"}  # read by the code at run time
 NOT_SOURCE = (".git", ".venv", "build", "dist", "__pycache__", ".pytest_cache", ".hypothesis")
 
 

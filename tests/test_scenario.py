@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 
 from helpers import BOOKS_WITH_DECOY
 from mtt_sim.sim import scenario
-from mtt_sim.sim.config import ConfigError
+from mtt_sim.core.settings import ConfigError
+from mtt_sim.core.validate import hints
 from mtt_sim.sim.scenario import load
 
 
@@ -78,7 +79,7 @@ def test_reference_table_documents_every_key():
 
     def keys(cls, prefix=""):
         for f in dataclasses.fields(cls):
-            tp = scenario._hints(cls)[f.name]
+            tp = hints(cls)[f.name]
             inner = getattr(tp, "__args__", (None,))[0]
             if dataclasses.is_dataclass(tp):
                 yield from keys(tp, prefix + f.name + ".")

@@ -7,10 +7,9 @@ from mtt_sim import TrackingEnv
 
 from mtt_sim.lab.episode import Episode
 from mtt_sim.sim2real import motion, truth_statistics
-from mtt_sim.sim.config import ConfigError
+from mtt_sim.core.frame import CLUTTER, Truth
+from mtt_sim.core.settings import ConfigError
 from mtt_sim.sim.scenario import load
-from mtt_sim.sim.sensor import CLUTTER
-from mtt_sim.sim.truth import Truth
 
 def run(key, steps, **kwargs):
     """Per-frame records of an episode of seed 0 without tracks: (truth, detections, frame mean, camera offset)."""

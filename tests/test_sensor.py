@@ -7,11 +7,11 @@ from hypothesis import strategies as st
 from helpers import placed, still, tiny
 from mtt_sim.sim2real import calibrate
 from mtt_sim.sim import sensor as sensor_mod
-from mtt_sim.sim.config import SensorConfig
-from mtt_sim.sim.sensor import CLUTTER, components, detection_probabilities
+from mtt_sim.core.settings import SensorConfig
+from mtt_sim.core.frame import CLUTTER, Truth
+from mtt_sim.sim.sensor import components, detection_probabilities
 from mtt_sim.env import TrackingEnv
 from mtt_sim.boxes import box_iou
-from mtt_sim.sim.truth import Truth
 
 
 def test_ideal_detector_returns_exactly_the_visible_boxes():

@@ -12,6 +12,7 @@ from mtt_sim import trackers
 from helpers import write_sequence
 from mtt_sim import TrackingEnv, cli
 from mtt_sim.lab import experiment
+from mtt_sim.metrics import PRINTED
 from mtt_sim.real import motchallenge
 from mtt_sim.real.sequence import Recording
 
@@ -133,7 +134,7 @@ def test_env_metrics_equal_the_written_results_file_scored(tmp_path, capsys):
     assert cli.main(["run", str(folder), "--tracker", "sort", "--results", str(out), "--json"]) == 0
     in_env = json.loads(capsys.readouterr().out)
     assert cli.main(["eval", "--gt", str(folder), "--results", str(out), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out) == {k: v for k, v in in_env.items() if k in cli.SUMMARY_KEYS}
+    assert json.loads(capsys.readouterr().out) == {k: v for k, v in in_env.items() if k in PRINTED}
     assert motchallenge.evaluate_results(folder, out, benchmark="MOT17") == experiment.run_episode(
         str(folder), "sort")["metrics"]
 

@@ -11,8 +11,7 @@ from helpers import tiny, write_sequence
 from mtt_sim import TrackingEnv, sources
 from mtt_sim.real.sequence import Recording
 from mtt_sim.sim.scene import Scene
-from mtt_sim.sim.sensor import Detections
-from mtt_sim.sim.truth import Truth
+from mtt_sim.core.frame import Detections, ScoredTruth, Truth
 
 A, B = (10.0, 10.0, 20.0, 40.0), (50.0, 20.0, 20.0, 40.0)
 GT = [(1, 1, *A, 1, 1, 1.0), (1, 2, *B, 1, 1, 1.0), (2, 1, *A, 1, 1, 1.0)]
@@ -63,8 +62,8 @@ def test_a_source_steps_through_its_frames(folder):
             truth, detections, image = source.observe(want_frame=True)
             assert isinstance(truth, Truth) and isinstance(detections, Detections)
             assert image.shape == (source.image_size[1], source.image_size[0], 3) and image.dtype == np.uint8
-            gt_ids, gt_boxes, kept, _ = source.scored_truth(np.zeros((0, 4)))
-            assert len(gt_ids) == len(gt_boxes)
+            scored = source.scored_truth(np.zeros((0, 4)))
+            assert isinstance(scored, ScoredTruth) and len(scored.ids) == len(scored.boxes)
             source.advance()
             frames += 1
         assert frames == (source.length or 3)

@@ -10,7 +10,7 @@ from mtt_sim import cli
 from mtt_sim.lab import stress
 from mtt_sim.lab.experiment import run_episode
 from mtt_sim.sim import scenario
-from mtt_sim.sim.config import ConfigError
+from mtt_sim.core.settings import ConfigError
 
 SHORT = {"env.max_steps": 30}
 

@@ -5,7 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import placed, still, tiny
-from mtt_sim.sim.truth import clip_boxes, overlapping_pairs
+from mtt_sim.boxes import clip_boxes, overlapping_pairs
 
 
 def test_unoccluded_target_is_fully_visible_with_its_exact_box():

@@ -1,4 +1,4 @@
-"""Fit the detector presets `dpm`, `frcnn` and `sdp` (mtt_sim/detectors/*.toml) to MOT17's public detectors.
+"""Fit the detector presets `dpm`, `frcnn` and `sdp` (mtt_sim/core/detectors/*.toml) to MOT17's public detectors.
 
 What is published about them is one number each, the average precision on MOT17 (MOTChallenge's MOT17Det
 benchmark: DPM 0.61, FRCNN 0.72, SDP 0.81). How a detector fails over time is not published, so every key but
@@ -7,7 +7,7 @@ detections): a preset is that detector with P(detect) shifted by one number d on
 bisection so that the average precision over mot17_like's people (seeds 0 and 1, 600 frames) is the published one,
 or as near as the shift can bring it (poor boxes, IoU 0.3 to 0.5 with the person, stay misses whatever d is).
 
-    python docs/experiments/fit_presets.py          # writes mtt_sim/detectors/{dpm,frcnn,sdp}.toml, prints the fit
+    python docs/experiments/fit_presets.py          # writes mtt_sim/core/detectors/{dpm,frcnn,sdp}.toml, prints the fit
 """
 
 from pathlib import Path
@@ -19,7 +19,7 @@ from mtt_sim.sim2real import calibrate
 from mtt_sim.sim import scenario
 
 PUBLISHED_AP = {"dpm": 0.61, "frcnn": 0.72, "sdp": 0.81}
-DETECTORS = Path(__file__).resolve().parents[2] / "mtt_sim" / "detectors"
+DETECTORS = Path(__file__).resolve().parents[2] / "mtt_sim" / "core" / "detectors"
 
 
 def shifted(base: dict, d: float) -> dict:

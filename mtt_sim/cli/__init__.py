@@ -17,9 +17,12 @@ from mtt_sim import __version__
 
 from mtt_sim.cli import (bench, calibrate, check_real, config, docs, evaluate, export, fit_scene, learn_policy,
                          learn_reid, listing, motion, perf, run, stress, sweep, tune, validate)
-from mtt_sim.cli.arguments import INTERRUPTED, SUMMARY_KEYS, UsageError
+from mtt_sim.cli.arguments import INTERRUPTED, UsageError
+from mtt_sim.core.moved import moved
 
-__all__ = ["SUMMARY_KEYS", "build_parser", "main"]
+__all__ = ["build_parser", "main"]
+# deprecated: the keys a summary prints are the metric families' declarations, mtt_sim.metrics.PRINTED
+__getattr__ = moved(__name__, "mtt_sim.metrics", SUMMARY_KEYS="PRINTED")
 COMMANDS = (listing, run, bench, sweep, stress, tune, fit_scene, learn_policy, perf, learn_reid, export, evaluate, check_real, calibrate,
             validate, motion, docs, config)  # the order of `mtt-sim --help`
 

@@ -21,11 +21,8 @@ from typing import Sequence
 from mtt_sim import sources
 from mtt_sim.real.layout import is_sequence
 from mtt_sim.sim import scenario
-from mtt_sim.sim.config import SensorConfig, table
+from mtt_sim.core.settings import SensorConfig, table
 
-SUMMARY_KEYS = ("MOTA", "MOTP", "IDF1", "HOTA", "DetA", "AssA", "LocA", "GOSPA", "CentreError", "TP", "FP", "FN", "IDSW",
-                "Frag", "MT", "PT", "ML", "Occlusions", "Reacquired", "HiddenCentreError", "num_frames", "num_gt_dets",
-                "num_gt_ids")
 MAX_SEEDS = 100_000  # more is a typo (0-99999999), not a grid anyone means to run
 INTERRUPTED = 130  # the shell's status for a command stopped by Ctrl-C (SIGTERM is treated the same way)
 SCENARIO_HELP = ("scenario key (see `mtt-sim list`, any case), env id (mtt_sim/Crossing-v0), .toml file or a "

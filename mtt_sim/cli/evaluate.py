@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from mtt_sim.cli.arguments import SUMMARY_KEYS, UsageError, add_dry_run, dry_run, estimate, fraction, print_summary
+from mtt_sim.cli.arguments import UsageError, add_dry_run, dry_run, estimate, fraction, print_summary
 from mtt_sim.sim import scenario
 
 
@@ -29,6 +29,7 @@ def run(args) -> int:
                                  ("--results", Path(args.results), "a results file")):
         if not path.is_file():
             raise UsageError(argument, f"{str(path)!r} not found; expected {kind}")
+    from mtt_sim.metrics import PRINTED
     from mtt_sim.real import motchallenge
 
     if args.dry_run:  # the files read and checked as the scoring reads them, nothing scored
@@ -39,7 +40,7 @@ def run(args) -> int:
     metrics = motchallenge.evaluate_results(args.gt, args.results, benchmark=args.benchmark, similarity=args.similarity,
                                             threshold=args.threshold, zero_distance=s.zero_distance,
                                             gospa_c=s.gospa_c, gospa_p=s.gospa_p)
-    summary = {k: metrics[k] for k in SUMMARY_KEYS}
+    summary = {k: metrics[k] for k in PRINTED}
     if args.json:
         print(json.dumps(summary))
         return 0

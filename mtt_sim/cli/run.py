@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, SCENARIO_HELP, SUMMARY_KEYS, UsageError, add_dry_run,
+from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, SCENARIO_HELP, UsageError, add_dry_run,
                                    add_overrides, dry_run, episode_overrides, estimate, integer, loaded, output_file,
                                    print_summary, replaced, scenario_key, tracker_spec, tracker_specs)
 
@@ -46,13 +46,14 @@ def run(args) -> int:
                               steps=args.steps)):
         return 0
     from mtt_sim.lab import experiment
+    from mtt_sim.metrics import PRINTED
 
     records = experiment.run_episodes(args.scenario, specs, args.seed, overrides, video=args.video, steps=args.steps,
                                       progress=True, scale=args.scale, results=args.results)
     for record in records:
         metrics = record["metrics"] or {"metrics": "none: the sequence has no gt/gt.txt"}
         summary = {"scenario": args.scenario, "tracker": record["tracker"], "seed": args.seed,
-                   **{k: metrics[k] for k in SUMMARY_KEYS if k in metrics}, **({} if record["metrics"] else metrics),
+                   **{k: metrics[k] for k in PRINTED if k in metrics}, **({} if record["metrics"] else metrics),
                    "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
         if args.json:
             print(json.dumps(summary))

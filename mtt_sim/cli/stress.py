@@ -18,7 +18,7 @@ SAMPLERS = ("tpe", "cmaes", "random")
 def dimensions(text: str) -> list:
     """--vary's comma-separated KEY=LO:HI and KEY=A|B items, each checked against the key's own range or choices."""
     from mtt_sim.lab import stress
-    from mtt_sim.sim.config import ConfigError
+    from mtt_sim.core.settings import ConfigError
 
     items = [t.strip() for t in text.split(",") if t.strip()]
     try:
@@ -86,7 +86,7 @@ def run(args) -> int:
     if out:
         require("matplotlib", "--out", "plot")
     from mtt_sim.lab import stress
-    from mtt_sim.sim.config import ConfigError
+    from mtt_sim.core.settings import ConfigError
 
     try:
         stress.check_bounds(args.scenario, args.vary, overrides)

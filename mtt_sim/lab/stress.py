@@ -26,7 +26,7 @@ from mtt_sim.lab.experiment import episode_pool, run_tasks
 from mtt_sim.lab.journal import Journal
 from mtt_sim.metrics import METRICS
 from mtt_sim.sim import scenario as scenarios
-from mtt_sim.sim.config import ConfigError
+from mtt_sim.core.settings import ConfigError
 
 SAMPLERS = ("tpe", "cmaes", "random")
 

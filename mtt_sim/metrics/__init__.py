@@ -1,10 +1,12 @@
 """Multi-object tracking metrics, as TrackEval (the MOTChallenge reference) computes them.
 
-`EpisodeMetrics.update` takes one frame of ground truth and tracks and does the per-frame work
-at once (similarities, the CLEAR matching, identity and HOTA counts); `summary` finishes the global
-parts (the IDF1 assignment, HOTA's second pass, GOSPA). `evaluate` runs both on a whole sequence.
-Modules: episode (EpisodeMetrics, evaluate), frame_log (what is kept of every frame), hota (the identity
-and HOTA passes), gospa, occlusion (the occlusion windows).
+`EpisodeMetrics.update` takes one frame of ground truth and tracks and hands it to each metric family (the
+similarities and the CLEAR matching at once; the frame logged for the global passes); `summary` finishes the global
+parts (the IDF1 assignment, HOTA's second pass, GOSPA). `evaluate` runs both on a whole sequence. Each family is a
+class that declares its fields (`family.Field`): the summary, `METRICS`, `PER_TARGET`, the keys the command line
+prints (`PRINTED`) and which way each metric is better (`goals`) come from the declarations.
+Modules: family (what a family is), episode (EpisodeMetrics, evaluate), frame_log (what is kept of every frame),
+clear (CLEAR and the centre errors), identity, hota, gospa, occlusion (the occlusion windows), goals.
 
 Semantics, following TrackEval where other tools differ:
 
@@ -35,7 +37,9 @@ Semantics, following TrackEval where other tools differ:
   `everyone`): see `mtt_sim.metrics.occlusion`.
 """
 
-from mtt_sim.metrics.episode import METRICS, PER_TARGET, EpisodeMetrics, FrameStats, evaluate
+from mtt_sim.metrics.clear import FrameStats
+from mtt_sim.metrics.episode import METRICS, PER_TARGET, PRINTED, SUMMARY_FIELDS, EpisodeMetrics, evaluate
 from mtt_sim.metrics.gospa import gospa, gospa_of_points
 
-__all__ = ["EpisodeMetrics", "FrameStats", "evaluate", "METRICS", "PER_TARGET", "gospa", "gospa_of_points"]
+__all__ = ["EpisodeMetrics", "FrameStats", "evaluate", "METRICS", "PER_TARGET", "PRINTED", "SUMMARY_FIELDS", "gospa",
+           "gospa_of_points"]

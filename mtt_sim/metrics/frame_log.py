@@ -1,6 +1,7 @@
 """The compact per-frame log of an episode, which the global passes (identity, HOTA, GOSPA, centre errors) read at
-the end: dense indices for ids, arrays that grow as rows are needed, and `FrameLog`, every frame's ids, centres,
-nonzero similarities and CLEAR matches in a few flat logs."""
+the end: dense indices for ids, arrays that grow as rows are needed, `FrameLog`, every frame's ids, centres,
+nonzero similarities and CLEAR matches in a few flat logs, and `FlatSimilarities`, the log's similarities laid out
+flat for the identity and HOTA passes."""
 
 from __future__ import annotations
 
@@ -73,6 +74,8 @@ class FrameLog:
     BATCH = 256
 
     def __init__(self):
+        self.gt_index, self.trk_index = IdIndex(), IdIndex()  # the episode's GT and tracker ids, densely indexed
+        self._flat: FlatSimilarities | None = None
         self._waiting: list[list] = []  # per frame: g, t, gt boxes, track boxes, rows, cols, sims, match rows, match cols
         self.counts = Log(np.int64, 4)
         self.gt, self.trk = Log(np.int32), Log(np.int32)
@@ -81,6 +84,8 @@ class FrameLog:
         self.match_row, self.match_col = Log(np.int32), Log(np.int32)
 
     def add_frame(self, g: np.ndarray, t: np.ndarray, gt_boxes: np.ndarray, trk_boxes: np.ndarray, sim: np.ndarray):
+        """A frame: its dense GT and tracker indices (`gt_index`, `trk_index`), boxes and similarities."""
+        self._flat = None
         if len(self._waiting) >= self.BATCH:
             self.flush()
         rows, cols = np.nonzero(sim > 0)  # similarities are never negative; a boolean scan is twice as fast
@@ -134,3 +139,40 @@ class FrameLog:
         starts, counts = self.starts(), self.counts.data
         frame = np.repeat(np.arange(len(self)), counts[:, 3])
         return starts[frame, 0] + self.match_row.data, starts[frame, 1] + self.match_col.data
+
+    def flat(self) -> FlatSimilarities:
+        """The similarities of every frame so far laid out flat (made once for the passes that read them)."""
+        if self._flat is None:
+            self._flat = FlatSimilarities(self, len(self.gt_index), len(self.trk_index))
+        return self._flat
+
+
+class FlatSimilarities:
+    """The nonzero similarities of every frame as flat arrays, with each one's GT id and tracker id.
+
+    This lets the global passes (identity, HOTA) run as a handful of vectorised operations over the
+    whole episode instead of a Python loop of small ones per frame; pairs of zero similarity never
+    count towards either. Entries run frame by frame, row-major within a frame (as np.nonzero gives them).
+    """
+
+    def __init__(self, log: FrameLog, num_gt_ids: int, num_trk_ids: int):
+        starts, counts = log.starts(), log.counts.data
+        self.n, self.m, self.nnz = counts[:, 0], counts[:, 1], counts[:, 2]
+        self.frame = np.repeat(np.arange(len(log)), self.nnz)  # each entry's frame
+        self.local_row, self.local_col = log.nz_row.data, log.nz_col.data
+        self.row = starts[self.frame, 0] + self.local_row  # index into the episode's GT rows
+        self.col = starts[self.frame, 1] + self.local_col  # index into the episode's tracker rows
+        self.sim = log.nz_sim.data
+        gcat, tcat = log.gt.data, log.trk.data
+        self.gt, self.trk = gcat[self.row], tcat[self.col]
+        self.gt_count = np.bincount(gcat, minlength=num_gt_ids)
+        self.trk_count = np.bincount(tcat, minlength=num_trk_ids)
+        self.num_gt_dets, self.num_trk_dets = len(gcat), len(tcat)
+
+    def crowded(self) -> np.ndarray:
+        """Per frame, whether some row or column holds two nonzero entries: only these frames need an assignment
+        solved."""
+        twice = (np.bincount(self.row)[self.row] > 1) | (np.bincount(self.col)[self.col] > 1)
+        out = np.zeros(len(self.n), bool)
+        out[self.frame[twice]] = True
+        return out

@@ -5,10 +5,9 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass
 
-from mtt_sim.metrics.episode import METRICS
+from mtt_sim.metrics.episode import METRICS, SUMMARY_FIELDS
 
-LOWER_IS_BETTER = {"FP", "FN", "IDSW", "Frag", "ML", "IDFP", "IDFN", "GOSPA", "CentreError", "CentreErrorVar",
-                   "HiddenCentreError"}  # counts of errors and distances; every other metric is better higher
+LOWER_IS_BETTER = {f.name for f in SUMMARY_FIELDS if f.lower_is_better}  # counts of errors, distances; the rest higher
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,29 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from mtt_sim.boxes import centres
+from mtt_sim.metrics.family import Field, LogPass
+from mtt_sim.metrics.frame_log import FrameLog
+
+
+class Gospa(LogPass):
+    """GOSPA of each frame's box centres with cut-off `c` and order `p`, its mean over the episode reported."""
+
+    FIELDS = (Field("GOSPA", lower_is_better=True, printed=True),)
+
+    def __init__(self, log: FrameLog, c: float, p: float):
+        super().__init__(log)
+        self.c, self.p = c, p
+
+    def frame(self, index: int = -1) -> float:
+        """GOSPA of one frame of the log (default: the latest)."""
+        return gospa_of_points(*self.log.points(index), self.c, self.p)
+
+    def summary(self) -> dict:
+        """The mean over frames of each frame's GOSPA."""
+        if not len(self.log):
+            return {"GOSPA": 0.0}
+        return {"GOSPA": float(np.mean([gospa_of_points(a, b, self.c, self.p)
+                                        for a, b in zip(*self.log.split_points())]))}
 
 
 def gospa(a: np.ndarray, b: np.ndarray, c: float, p: float) -> float:

@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from mtt_sim.boxes import centres, check_frame, rows_of
+from mtt_sim.metrics.clear import Clear
+from mtt_sim.metrics.family import Field, Frame
 from mtt_sim.metrics.frame_log import Grow, IdIndex
 
 HIDDEN, REVEALED, WINDOW = 0.05, 0.5, 20  # the occlusion windows' visibilities and frames (module docstring)
@@ -25,9 +27,15 @@ _CLEAR, _HIDDEN, _WINDOW = 0, 1, 2  # a target's occlusion: none under way, hidd
 
 
 class OcclusionWindows:
-    """The occlusion-window measures (module docstring), kept per target id in growing arrays."""
+    """The occlusion-window measures (module docstring), kept per target id in growing arrays; a target's holder is
+    the track that `clear` matched to it."""
 
-    def __init__(self):
+    FIELDS = (Field("HiddenCentreError", lower_is_better=True, printed=True), Field("Reacquired", printed=True),
+              Field("Occlusions", int, printed=True))
+    PER_TARGET = (Field("HiddenCentreError", lower_is_better=True), Field("Reacquired"))
+
+    def __init__(self, clear: Clear):
+        self.clear = clear
         self.ids = IdIndex()
         self.holder = Grow(-1, np.int64)      # tracker id of the latest match
         self.stage = Grow(_CLEAR, np.int8)    # where each target's occlusion stands
@@ -38,7 +46,13 @@ class OcclusionWindows:
         self.decided = Grow(0, np.int64, 2)   # occlusions re-acquired, occlusions decided
         self.frame = -1
 
-    def update(self, ids, boxes, visibility, trk_ids, trk_boxes, matched_gt, matched_trk) -> None:
+    def update(self, frame: Frame) -> None:
+        """One frame with everyone in view (none: nothing to score), after CLEAR matched it."""
+        if frame.everyone is not None:
+            rows, cols = self.clear.pairs
+            self._update(*frame.everyone, frame.trk_ids, frame.trk_boxes, frame.gt_ids[rows], frame.trk_ids[cols])
+
+    def _update(self, ids, boxes, visibility, trk_ids, trk_boxes, matched_gt, matched_trk) -> None:
         """One frame: every target in view (ids, boxes, visibility), the reported tracks, the CLEAR matches. Most
         frames have nobody hidden and no occlusion under way: they only note who holds whom."""
         self.frame += 1

@@ -10,7 +10,9 @@ a time when asked for. Ground truth is scored as TrackEval's MotChallenge2DBox s
 The truth the env shows holds the people (classes a person detector fires on) with their visible fraction: the
 visibility column where the benchmark has one (MOT16/17/20; not used for scoring, as in TrackEval), else measured from
 box overlaps (the box whose bottom edge is lower is nearer). With `sensor.model = "synthetic"` that truth is replayed
-through the synthetic detector (a digital twin of the sequence) instead of reading det/det.txt.
+through the synthetic detector (a digital twin of the sequence) instead of reading det/det.txt; that detector is the
+simulator's, handed in as `twin` (`mtt_sim.sources.open_source` does), so that this module needs nothing of the
+simulator: its types and configuration tables live below both sources, in `mtt_sim.core`.
 
 `Recording` implements `mtt_sim.sources.Source`, the interface a simulated scene implements too.
 """
@@ -20,17 +22,16 @@ from __future__ import annotations
 import configparser
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
+from typing import Callable, Mapping
 
 import cv2
 import numpy as np
 
-from mtt_sim.boxes import EPS, box_iou, match
+from mtt_sim.boxes import EPS, box_iou, match, occlusion_visibility
+from mtt_sim.core.frame import Detections, ScoredTruth, Truth
+from mtt_sim.core.settings import ConfigError, EnvConfig, ScoringConfig, SensorConfig, table
+from mtt_sim.core.validate import build, expand_dotted, merge
 from mtt_sim.real.layout import is_sequence
-from mtt_sim.sim import scenario as scn
-from mtt_sim.sim.config import EnvConfig, GroupConfig, ScoringConfig, SensorConfig, table
-from mtt_sim.sim.sensor import Detections, SyntheticSensor
-from mtt_sim.sim.truth import Truth, occlusion_visibility
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20")
 PEDESTRIAN = 1
@@ -39,6 +40,7 @@ PEOPLE = (1, 2, 7, 8, 12)  # pedestrian, person on vehicle, static person, distr
 VALID_CLASSES = range(1, 14)
 FRAME_RATE = 30.0  # where there is no seqinfo.ini
 REQUIRED_INFO = ("frameRate", "seqLength", "imWidth", "imHeight")  # what a seqinfo.ini must give
+Twin = Callable[[SensorConfig, tuple[int, int], np.random.Generator], object]  # makes a detector: .detect(Truth)
 
 
 @dataclass(frozen=True)
@@ -67,14 +69,16 @@ class SequenceInfo:
 class Recording:
     """One sequence's detections, ground truth and frames, frame by frame (frame k = file frame k + 1), and the source
     that replays them: `reset`, then `observe` and `advance` frame by frame. `overrides` take env.*, scoring.* and
-    sensor.* keys; sensor.model = "synthetic" replays the people through the synthetic detector (the twin)."""
+    sensor.* keys; sensor.model = "synthetic" replays the people through the synthetic detector (the twin) that `twin`
+    makes (`mtt_sim.sim.sensor.twin_sensor`)."""
 
     detection_dtype = np.float64  # detections are handed on as written
 
-    def __init__(self, folder, benchmark: str | None = None, overrides: Mapping | None = None):
+    def __init__(self, folder, benchmark: str | None = None, overrides: Mapping | None = None,
+                 twin: Twin | None = None):
         self.folder = Path(folder)
         if not is_sequence(self.folder):
-            raise scn.ConfigError(f"{folder}: not a MOTChallenge sequence folder (expected seqinfo.ini, det/det.txt or "
+            raise ConfigError(f"{folder}: not a MOTChallenge sequence folder (expected seqinfo.ini, det/det.txt or "
                                   "gt/gt.txt in it)")
         det_file, gt_file = self.folder / "det" / "det.txt", self.folder / "gt" / "gt.txt"
         det = read_rows(det_file, 7) if det_file.is_file() else np.zeros((0, 7))
@@ -87,7 +91,7 @@ class Recording:
         self.scored = gt is not None
         self.benchmark = benchmark or _benchmark_of(self.info.name, gt)
         if self.benchmark not in BENCHMARKS:
-            raise scn.ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
+            raise ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
         self._det = by_frame(det, self.info.length)
         self._gt = by_frame(_gt_table(gt, self.benchmark, gt_file), self.info.length)
         self.has_visibility = gt is not None and gt.shape[1] > 8 and self.benchmark != "MOT15"
@@ -100,7 +104,12 @@ class Recording:
         self.config = self._configure(overrides or {})
         self.image_size = (self.info.width, self.info.height)
         self.frame_rate, self.length = self.info.frame_rate, self.info.length
-        self.sensor: SyntheticSensor | None = None
+        if self.config.sensor.model == "synthetic" and twin is None:
+            raise ConfigError(f"{self.folder}: sensor.model = 'synthetic' replays the ground truth through the "
+                              "simulator's detector: open the sequence with mtt_sim.sources.open_source, or pass "
+                              "twin=mtt_sim.sim.sensor.twin_sensor")
+        self.twin = twin
+        self.sensor = None  # the twin's detector, while it runs
         self.k = 0
 
     def __len__(self) -> int:
@@ -146,29 +155,29 @@ class Recording:
     def _configure(self, overrides: Mapping) -> SequenceConfig:
         """The configuration this sequence runs with: detection rows and episode length from the data; `env.*` and
         `scoring.*` keys can be overridden, and `sensor.*` keys for the synthetic detector (the twin)."""
-        overrides = scn.expand_dotted(overrides)
+        overrides = expand_dotted(overrides)
         other = sorted(set(overrides) - {"env", "scoring", "sensor"})
         if other:
-            raise scn.ConfigError(f"{self.folder}: a recorded sequence takes only env.*, scoring.* and sensor.* "
+            raise ConfigError(f"{self.folder}: a recorded sequence takes only env.*, scoring.* and sensor.* "
                                   f"overrides, not {other[0]}.*")
         sensor = overrides.get("sensor", {})
         model = sensor.get("model", "recorded")
         if model == "foreground":
-            raise scn.ConfigError(f"{self.folder}: sensor.model = 'foreground' needs frames the simulator rendered; "
+            raise ConfigError(f"{self.folder}: sensor.model = 'foreground' needs frames the simulator rendered; "
                                   "a recorded sequence takes 'recorded' (its det/det.txt) or 'synthetic' (its twin)")
         if model == "recorded" and set(sensor) - {"model"}:
             key = sorted(set(sensor) - {"model"})[0]
-            raise scn.ConfigError(f"{self.folder}: sensor.{key} applies to the synthetic detector; add "
+            raise ConfigError(f"{self.folder}: sensor.{key} applies to the synthetic detector; add "
                                   "sensor.model = 'synthetic' (--detector synthetic) to replay the ground truth through it")
         obs_mode = overrides.get("env", {}).get("obs_mode")
         if obs_mode == "frame+detections" and not self.has_images:
-            raise scn.ConfigError(f"{self.folder}: env.obs_mode = 'frame+detections', but the sequence has no "
+            raise ConfigError(f"{self.folder}: env.obs_mode = 'frame+detections', but the sequence has no "
                                   f"{self.info.image_dir}/ folder of frames; use obs_mode='detections'")
         raw = {"sensor": {"model": "recorded", "max_detections": max(1, self.max_detections)} if model == "recorded"
                else {},
                "env": {"max_steps": self.info.length,
                        "obs_mode": "frame+detections" if self.has_images else "detections"}}
-        return scn.from_mapping(scn.merge(raw, overrides), str(self.folder), SequenceConfig)
+        return build(merge(raw, overrides), str(self.folder), SequenceConfig)
 
     # ------------------------------------------------------------ the source
 
@@ -186,7 +195,7 @@ class Recording:
               sensor_rng: np.random.Generator) -> None:
         """Back to the first frame; the twin's detector starts afresh from `sensor_rng` (the others are unused)."""
         self.k = 0
-        self.sensor = twin_sensor(self.config.sensor, self.image_size, sensor_rng) \
+        self.sensor = self.twin(self.config.sensor, self.image_size, sensor_rng) \
             if self.config.sensor.model == "synthetic" else None
 
     def observe(self, want_frame: bool) -> tuple[Truth, Detections, np.ndarray | None]:
@@ -205,9 +214,9 @@ class Recording:
         """Ids and boxes of the scored targets of the first frame (for trackers initialised by hand)."""
         return self.scoring(0, np.zeros((0, 4)))[:2]
 
-    def scored_truth(self, track_boxes: np.ndarray):
+    def scored_truth(self, track_boxes: np.ndarray) -> ScoredTruth:
         """`scoring` of the current frame, and no view of the hidden targets (a sequence has no occlusion windows)."""
-        return *self.scoring(self.k, track_boxes), None
+        return ScoredTruth(*self.scoring(self.k, track_boxes), in_view=None)
 
     def advance(self) -> None:
         self.k += 1
@@ -215,12 +224,6 @@ class Recording:
     @property
     def finished(self) -> bool:
         return self.k >= len(self)
-
-
-def twin_sensor(cfg: SensorConfig, image_size: tuple[int, int], rng: np.random.Generator) -> SyntheticSensor:
-    """The synthetic detector on a recorded sequence's people (its twin); clutter takes the size of a default target
-    when nobody is in view."""
-    return SyntheticSensor(cfg, image_size, np.array([GroupConfig().size], float), rng)
 
 
 def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
@@ -232,10 +235,10 @@ def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
     try:
         found = ini.read(path)
     except (configparser.Error, UnicodeDecodeError) as err:
-        raise scn.ConfigError(f"{path}: not an INI file with a [Sequence] section "
+        raise ConfigError(f"{path}: not an INI file with a [Sequence] section "
                               f"({str(err).splitlines()[0].rstrip('.')})") from None
     if found and "Sequence" not in ini:
-        raise scn.ConfigError(f"{path}: no [Sequence] section (expected name, frameRate, seqLength, imWidth, imHeight)")
+        raise ConfigError(f"{path}: no [Sequence] section (expected name, frameRate, seqLength, imWidth, imHeight)")
     section = ini["Sequence"] if found else {}
     image_dir, image_ext = section.get("imDir", "img1"), section.get("imExt", ".jpg")
     images = sorted((folder / image_dir).glob(f"*{image_ext}")) if (folder / image_dir).is_dir() else []
@@ -250,7 +253,7 @@ def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
         except ValueError:
             value = 0
         if value <= 0:
-            raise scn.ConfigError(f"{folder / 'seqinfo.ini'}: {key} = {text!r}: expected a positive number")
+            raise ConfigError(f"{folder / 'seqinfo.ini'}: {key} = {text!r}: expected a positive number")
         return value
 
     def image_size():
@@ -267,7 +270,7 @@ def _read_info(folder: Path, data: list[np.ndarray]) -> SequenceInfo:
     frame_rate = float(number("frameRate", float, lambda: FRAME_RATE))
     missing = [key for key in REQUIRED_INFO if key not in section]
     if found and missing:  # a seqinfo.ini that leaves one out is a mistake, not a sequence to guess the size of
-        raise scn.ConfigError(f"{path}: [Sequence] has no {missing[0]}; a seqinfo.ini gives "
+        raise ConfigError(f"{path}: [Sequence] has no {missing[0]}; a seqinfo.ini gives "
                               f"{', '.join(REQUIRED_INFO)} (leave the file out to take them from the frames and data)")
     return SequenceInfo(section.get("name", folder.name), width, height, frame_rate, length, image_dir, image_ext)
 

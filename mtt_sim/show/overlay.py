@@ -6,7 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from mtt_sim.sim.truth import Truth
+from mtt_sim.core.frame import Truth
 
 # The truth is magenta, the detections cyan: far from every fixed colour a shipped scene paints (its backgrounds are
 # grey, brown, green or near white, its occluders grey, brown or yellow, its uniform targets red, dark or white; only

@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from mtt_sim.core.frame import Detections, ScoredTruth, Truth
+from mtt_sim.core.settings import ConfigError
 from mtt_sim.sim.camera import read_warps
-from mtt_sim.sim.config import ConfigError, Scenario
+from mtt_sim.sim.config import Scenario
 from mtt_sim.sim.render import Renderer
-from mtt_sim.sim.sensor import Detections, Sensor, make_sensor
-from mtt_sim.sim.truth import Truth, measure
+from mtt_sim.sim.sensor import Sensor, make_sensor
+from mtt_sim.sim.truth import measure
 from mtt_sim.sim.world import World
 
 
@@ -74,12 +76,13 @@ class Scene:
         seen = self.truth.visibility > 0
         return self.truth.ids[seen].copy(), self.truth.boxes[seen].copy()
 
-    def scored_truth(self, track_boxes: np.ndarray):
-        """The current frame's scored ground truth (ids, boxes), which tracks are scored, and everyone in view (ids,
-        boxes, visibility: the occlusion windows need the hidden targets too)."""
+    def scored_truth(self, track_boxes: np.ndarray) -> ScoredTruth:
+        """The current frame's scored ground truth (ids, boxes), every track scored, and everyone in view (ids, boxes,
+        visibility: the occlusion windows need the hidden targets too)."""
         t = self.truth
         scored = t.visibility >= self.config.scoring.min_visibility
-        return t.ids[scored], t.boxes[scored], slice(None), (t.ids, t.boxes, t.visibility)
+        return ScoredTruth(t.ids[scored], t.boxes[scored], scored_tracks=slice(None),
+                           in_view=(t.ids, t.boxes, t.visibility))
 
     def advance(self) -> None:
         self.world.step()

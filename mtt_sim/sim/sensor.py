@@ -16,31 +16,20 @@ subtraction, morphology and connected components on the rendered frame, so fragm
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import cv2
 import numpy as np
 from scipy.special import expit, logit
 
-from mtt_sim.boxes import pair_iou, rows_of, union_boxes
-from mtt_sim.sim.config import Scenario, SensorConfig
-from mtt_sim.sim.truth import Truth, clip_boxes, overlapping_pairs
+from mtt_sim.boxes import clip_boxes, overlapping_pairs, pair_iou, rows_of, union_boxes
+from mtt_sim.core.frame import CLUTTER, UNKNOWN, Detections, Truth
+from mtt_sim.core.settings import SensorConfig
+from mtt_sim.sim.config import GroupConfig, Scenario
 
-CLUTTER = -1   # source of a false detection
-UNKNOWN = 0    # source of a foreground blob (the image does not say which target made it)
 TRUE_BAND = (0.5, 1.01)    # IoU with its target of a true detection's box (its noise is drawn within)
 OUTLIER_BAND = (0.3, 0.5)  # IoU with its target of an outlier box: detected, badly (calibrate associates at 0.3)
 BESIDE_BAND = (0.1, 0.3)   # IoU with its target of a site held beside it: a false positive, not its detection
 _BAND_TRIES = 8
 MISSED, GOOD, POOR = 0, 1, 2  # how a target was reported: not at all, with a true box, with an outlier box
-
-
-@dataclass(frozen=True)
-class Detections:
-    """One frame's detections: rows x, y, w, h, confidence, and the target id behind each (for tests and overlays)."""
-
-    rows: np.ndarray     # (n, 5) float32
-    sources: np.ndarray  # (n,) int64: target id, CLUTTER or UNKNOWN
 
 
 def detection_probabilities(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig,
@@ -428,3 +417,9 @@ def make_sensor(sc: Scenario, rng: np.random.Generator, background: np.ndarray |
     if sc.sensor.model == "foreground":
         return ForegroundSensor(*parts, background)
     return SyntheticSensor(*parts)
+
+
+def twin_sensor(cfg: SensorConfig, image_size: tuple[int, int], rng: np.random.Generator) -> SyntheticSensor:
+    """The synthetic detector on a recorded sequence's people (its twin); clutter takes the size of a default target
+    when nobody is in view."""
+    return SyntheticSensor(cfg, image_size, np.array([GroupConfig().size], float), rng)

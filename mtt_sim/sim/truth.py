@@ -4,81 +4,22 @@ A target that nothing is drawn over and that lies wholly inside the image is ful
 its box is exact geometry. Only the others (overlapped by something drawn later, or cut by the
 image border) are measured on the label map, inside their own box: visible pixels over the pixels
 the target would cover alone, the bounding box of the visible pixels, and the connected pieces the
-visible region falls into. That keeps the cost proportional to the number of occlusions.
+visible region falls into. That keeps the cost proportional to the number of occlusions. The `Truth` type itself
+lives below both sources, in `mtt_sim.core.frame`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import cv2
 import numpy as np
 
+from mtt_sim import boxes as box_geometry
+from mtt_sim.boxes import clip_boxes, overlapping_pairs
+from mtt_sim.core.frame import Truth
+from mtt_sim.core.moved import moved
 from mtt_sim.sim.render import draw_blob, draw_fixed, fixed_point
 
-
-@dataclass(frozen=True)
-class Truth:
-    """Ground truth of the targets inside the image at one frame (rows aligned)."""
-
-    ids: np.ndarray            # (n,) int64, unique over the episode
-    boxes: np.ndarray          # (n, 4) float32, full extent x, y, w, h clipped to the image
-    visibility: np.ndarray     # (n,) float32 in [0, 1]: visible pixels / pixels of the unoccluded shape in the image
-    visible_boxes: np.ndarray  # (n, 4) float32, extent of the visible pixels (zeros where none)
-    depth: np.ndarray          # (n,) float32, larger = nearer the viewer
-    labels: np.ndarray         # (n,) int, the value of this target in the label map
-    pieces: np.ndarray         # (p, 5) float32: row index into these arrays, x, y, w, h of each visible piece
-                               # of a target whose visible region falls apart (all pieces of such a target)
-
-    def __len__(self) -> int:
-        return len(self.ids)
-
-
-def clip_boxes(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Boxes (n, 4) x, y, w, h clipped to the image; fully outside boxes get zero size."""
-    boxes = np.asarray(boxes, np.float64)  # float32 corners would round x + w
-    corners = np.concatenate([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]], axis=1)
-    np.clip(corners, 0, (width, height, width, height), out=corners)
-    corners[:, 2:] -= corners[:, :2]
-    return corners
-
-
-def occlusion_visibility(boxes: np.ndarray, width: int, height: int, grid: tuple[int, int] = (8, 16)) -> np.ndarray:
-    """Visible fraction of each box x, y, w, h of people on a ground plane: a box whose bottom edge is lower stands
-    nearer and hides what it covers, and the image border hides what lies outside. Measured on a grid of points (8
-    across, 16 down) in each box: the share that lies in the image and that no nearer box covers."""
-    n = len(boxes)
-    if not n:
-        return np.zeros(0)
-    u = (np.arange(grid[0]) + 0.5) / grid[0]
-    v = (np.arange(grid[1]) + 0.5) / grid[1]
-    px = (boxes[:, 0, None] + boxes[:, 2, None] * u).repeat(grid[1], axis=1)  # (n, points)
-    py = np.tile(boxes[:, 1, None] + boxes[:, 3, None] * v, grid[0])
-    bottom = boxes[:, 1] + boxes[:, 3]
-    seen = (px >= 0) & (px < width) & (py >= 0) & (py < height)
-    for i, j in zip(*overlapping_pairs(boxes)):  # each pair once: the nearer box hides part of the farther one
-        near, far = (i, j) if bottom[i] > bottom[j] else (j, i)
-        if bottom[near] == bottom[far]:
-            continue
-        b = boxes[near]
-        seen[far] &= ~((px[far] >= b[0]) & (px[far] < b[0] + b[2]) & (py[far] >= b[1]) & (py[far] < b[1] + b[3]))
-    return seen.mean(axis=1)
-
-
-def overlapping_pairs(boxes: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Index pairs (i, j), i != j, each pair once, of boxes x, y, w, h that intersect or come within `margin`.
-
-    Sort and sweep along x, then test y on the candidate pairs: O(n log n + pairs) instead of an n x n matrix.
-    """
-    n = len(boxes)
-    order = np.argsort(boxes[:, 0], kind="stable")
-    b = boxes[order]
-    end = np.searchsorted(b[:, 0], b[:, 0] + b[:, 2] + margin, side="left")
-    counts = np.maximum(end - np.arange(n) - 1, 0)
-    k = np.repeat(np.arange(n), counts)
-    l = k + 1 + np.arange(len(k)) - np.repeat(np.cumsum(counts) - counts, counts)
-    ok = (b[k, 1] < b[l, 1] + b[l, 3] + margin) & (b[l, 1] < b[k, 1] + b[k, 3] + margin)
-    return order[k[ok]], order[l[ok]]
+__getattr__ = moved(__name__, box_geometry, "occlusion_visibility")  # deprecated: import it from mtt_sim.boxes
 
 
 def _covered(boxes: np.ndarray, depth: np.ndarray, over_boxes: np.ndarray, over_depth: np.ndarray) -> np.ndarray:

@@ -32,11 +32,12 @@ import numpy as np
 from scipy.optimize import brentq, least_squares, minimize
 from scipy.special import expit, logit, logsumexp
 
+from mtt_sim.boxes import box_iou, match, overlap, overlapping_pairs, union_boxes
+from mtt_sim.core.frame import Truth
+from mtt_sim.real.sequence import Recording, SequenceConfig
 from mtt_sim.sim import scenario as scn
+from mtt_sim.sim.sensor import twin_sensor
 from mtt_sim.sim2real import truth_statistics
-from mtt_sim.boxes import box_iou, match, overlap, union_boxes
-from mtt_sim.real.sequence import Recording, SequenceConfig, twin_sensor
-from mtt_sim.sim.truth import Truth, overlapping_pairs
 
 MATCH_IOU = 0.5     # a true detection
 OUTLIER_IOU = 0.3   # a detection of the person with a poor box

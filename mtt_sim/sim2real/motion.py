@@ -118,7 +118,8 @@ def scored_frames(source: str, config: dict | None = None, seed: int = 0, steps:
     env = TrackingEnv(source, config=overrides_for(source, config), obs_mode="detections")
     no_tracks, frames = np.zeros((0, 4)), []
     for _ in Episode(env, seed, steps=steps):
-        frames.append(env.source.scored_truth(no_tracks)[:2])
+        truth = env.source.scored_truth(no_tracks)
+        frames.append((truth.ids, truth.boxes))
         if warps is not None and hasattr(env.source, "camera_warp"):
             warps.append(env.source.camera_warp)
     return frames, env.source.frame_rate, env.source.image_size

@@ -7,7 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-from mtt_sim.sim.truth import Truth
+from mtt_sim.core.frame import Truth
 
 LAG = 5            # frames over which a heading is measured
 MIN_MOVE = 0.1     # a heading counts where the feet moved at least this share of the box height over LAG frames
