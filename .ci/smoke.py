@@ -96,6 +96,8 @@ def main() -> int:
         ("calibrate", [str(a), "--out", f"{t}/fitted.toml", "--seeds", "1"]),
         ("fit-scene", [str(b), "--sensor", f"{t}/fitted.toml", "--out", f"{t}/scene.toml", "--seeds", "1"]),
         ("run", [f"{t}/scene.toml", "--tracker", "sort", "--steps", "20"]),
+        ("advise", [str(b), "--sensor", f"{t}/fitted.toml", "--trackers", "sort,iou", "--trials", "2", "--seeds", "1",
+                    "--out", f"{t}/advice.md"]),
         ("validate", [str(a), str(b), "--trackers", "sort", "--seeds", "1", "--out", f"{t}/validate.md"]),
         ("motion", [str(a), str(b), "--fit", f"{t}/walkers.toml", "--plot", f"{t}/motion.png"]),
         ("run", ["crossing", "--steps", "20", "--config", "walk.model=langevin", "world.frame_rate=14"]),

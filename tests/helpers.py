@@ -104,3 +104,13 @@ def write_sequence(folder, det=(), gt=None, length=None, size=(100, 80), images=
             cv2.imwrite(str(folder / "img1" / f"{f:06d}{'.png' if seqinfo else '.jpg'}"),
                         np.full((size[1], size[0], 3), 10 * f, np.uint8))
     return folder
+
+
+def exit_code(argv: list[str]) -> int:
+    """`mtt-sim ARGV`'s exit status, argparse's own refusals (SystemExit) included."""
+    from mtt_sim import cli
+
+    try:
+        return cli.main(argv)
+    except SystemExit as done:
+        return done.code

@@ -15,7 +15,7 @@ import sys
 
 from mtt_sim import __version__
 
-from mtt_sim.cli import (bench, calibrate, check_real, config, docs, evaluate, export, fit_scene, learn_policy,
+from mtt_sim.cli import (advise, bench, calibrate, check_real, config, docs, evaluate, export, fit_scene, learn_policy,
                          learn_reid, listing, motion, perf, run, stress, sweep, tune, validate)
 from mtt_sim.cli.arguments import INTERRUPTED, UsageError
 from mtt_sim.core.moved import moved
@@ -23,8 +23,8 @@ from mtt_sim.core.moved import moved
 __all__ = ["build_parser", "main"]
 # deprecated: the keys a summary prints are the metric families' declarations, mtt_sim.metrics.PRINTED
 __getattr__ = moved(__name__, "mtt_sim.metrics", SUMMARY_KEYS="PRINTED")
-COMMANDS = (listing, run, bench, sweep, stress, tune, fit_scene, learn_policy, perf, learn_reid, export, evaluate, check_real, calibrate,
-            validate, motion, docs, config)  # the order of `mtt-sim --help`
+COMMANDS = (listing, run, bench, sweep, stress, tune, fit_scene, advise, learn_policy, perf, learn_reid, export, evaluate,
+            check_real, calibrate, validate, motion, docs, config)  # the order of `mtt-sim --help`
 
 
 class _Parser(argparse.ArgumentParser):

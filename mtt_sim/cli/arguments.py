@@ -271,16 +271,22 @@ class _SensorFile:
     sensor: SensorConfig = table(SensorConfig, "the detector")
 
 
+def check_sensor(path: str) -> dict:
+    """The --sensor file's [sensor] table, every key and value checked before any work (a UsageError names the
+    problem)."""
+    try:
+        sensor = scenario.read_sensor(path)
+        scenario.from_mapping(sensor, path, _SensorFile)
+    except scenario.ConfigError as err:
+        raise UsageError("--sensor", str(err)) from None
+    return sensor
+
+
 def episode_overrides(args) -> dict:
     """The episode's overrides: --sensor's [sensor] table, then --detector's model, then --config (the last wins)."""
     out = {}
     if args.sensor:
-        try:
-            sensor = scenario.read_sensor(args.sensor)
-            scenario.from_mapping(sensor, args.sensor, _SensorFile)  # every key and value of the file checked
-        except scenario.ConfigError as err:
-            raise UsageError("--sensor", str(err)) from None
-        out.update({f"sensor.{k}": v for k, v in sensor["sensor"].items()})
+        out.update({f"sensor.{k}": v for k, v in check_sensor(args.sensor)["sensor"].items()})
     if args.detector:
         out["sensor.model"] = args.detector
     out.update(parse_overrides(args.config))

@@ -7,7 +7,7 @@ import argparse
 import shlex
 from pathlib import Path
 
-from mtt_sim.cli.arguments import (FORCE_HELP, UsageError, add_dry_run, dry_run, estimate, integer, output_file,
+from mtt_sim.cli.arguments import (FORCE_HELP, add_dry_run, check_sensor, dry_run, estimate, integer, output_file,
                                    replaced, rows_in, sequence_read)
 
 
@@ -37,14 +37,9 @@ def add(subparsers) -> None:
 
 def run(args) -> int:
     out = output_file(args.out, args.force, "--out", (".toml",))
-    from mtt_sim.cli.arguments import _SensorFile
-    from mtt_sim.sim import scenario
+    check_sensor(args.sensor)
     from mtt_sim.sim2real import fit_scene
 
-    try:  # a bad sensor file fails before any work, every key checked
-        scenario.from_mapping(scenario.read_sensor(args.sensor), args.sensor, _SensorFile)
-    except scenario.ConfigError as err:
-        raise UsageError("--sensor", str(err)) from None
     if dry_run(args, estimate("fit-scene", [(1 + args.seeds, "runs (the sequence linked, then the scene's seeds)")],
                               [args.folder], {"sensor.model": "synthetic"})):
         return 0

@@ -128,7 +128,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
                 if failed:
                     trial.set_user_attr("error", failed[0])
                     raise RuntimeError(f"{trial_spec} on {source}: {failed[0]}")
-                values += [[_score(r, g.metric) for g in wanted] for r in records]
+                values += [[score(r, g.metric) for g in wanted] for r in records]
                 if len(wanted) == 1:
                     trial.report(_mean(values, 0), step)
                     if step < len(sources) - 1 and trial.should_prune():
@@ -248,7 +248,8 @@ def _note(result: Result | None, study, trials: int, kept: int) -> None:
                                                                      trials, kept)
 
 
-def _score(record: dict, metric: str) -> float:
+def score(record: dict, metric: str) -> float:
+    """An episode record's `metric`; an unscored one is an error, not a zero."""
     value = (record["metrics"] or {}).get(metric)
     if value is None:
         raise RuntimeError(f"{record['scenario']}: no {metric} (an unscored source, or nothing to count)")

@@ -26,17 +26,26 @@ STANDING = 0.1  # heights per second: slower than this, a person stands
 def track_rows(frames: Iterable[tuple[np.ndarray, np.ndarray]]) -> dict[int, np.ndarray]:
     """Per id, (frame, foot x, foot y, height) rows over every frame from its first to its last, from each frame's
     (ids, boxes x, y, w, h); frames where an id is missing are filled linearly between its neighbours."""
-    rows: dict[int, list] = {}
-    for k, (ids, boxes) in enumerate(frames):
-        boxes = np.asarray(boxes, float).reshape(-1, 4)
-        for i, x, y, h in zip(np.asarray(ids).tolist(), boxes[:, 0] + boxes[:, 2] / 2, boxes[:, 1] + boxes[:, 3],
-                              boxes[:, 3]):
-            rows.setdefault(i, []).append((k, x, y, h))
+    ids, boxes, at = [], [], []
+    for k, (i, b) in enumerate(frames):
+        ids.append(np.asarray(i, np.int64).ravel())
+        boxes.append(np.asarray(b, float).reshape(-1, 4))
+        at.append(np.full(len(ids[-1]), k))
+    if not ids or not sum(map(len, ids)):
+        return {}
+    ids, boxes, at = np.concatenate(ids), np.concatenate(boxes), np.concatenate(at)
+    order = np.lexsort((at, ids))  # by id, then frame
+    ids, at = ids[order], at[order]
+    seen = np.c_[at, boxes[order, 0] + boxes[order, 2] / 2, boxes[order, 1] + boxes[order, 3], boxes[order, 3]]
+    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
+    ends = np.r_[starts[1:], len(ids)]
+    first_seen = np.argsort(order[starts], kind="stable")  # the ids in the order they first appear
     out = {}
-    for i, seen in rows.items():
-        seen = np.array(seen)
-        every = np.arange(seen[0, 0], seen[-1, 0] + 1)
-        out[i] = np.c_[every, *(np.interp(every, seen[:, 0], seen[:, c]) for c in (1, 2, 3))]
+    for i, a, b in zip(ids[starts[first_seen]].tolist(), starts[first_seen], ends[first_seen]):
+        rows = seen[a:b]
+        every = np.arange(rows[0, 0], rows[-1, 0] + 1)
+        out[i] = np.c_[every, *(np.interp(every, rows[:, 0], rows[:, c]) for c in (1, 2, 3))] if len(every) > len(rows) \
+            else rows
     return out
 
 

@@ -1,0 +1,110 @@
+"""The label-free route in one step (`mtt-sim advise`): for a camera with detections and no labels, fit its scene
+(`fit_scene`), tune each candidate tracker on it (`tune`) and rank them by the tuned score, with the simulator's
+confidence: each tuned spec's spread over the scene's seeds and how often the first beats the others seed by seed.
+
+What the ranking is worth on real video is measured, not assumed: TRUST holds the figures of the label-free route on
+the shared MOT15 sequences (docs/tuning.md), per kind of camera, and `warnings` turns them into the lines a user of a
+camera of that kind should read before trusting the ranking.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+from dataclasses import asdict, dataclass
+from typing import Callable, Sequence
+
+CANDIDATES = ("sort", "bytetrack", "ocsort", "iou", "gmphd")  # fast and sound on every shared sequence
+# The label-free route measured on the eight shared MOT15 sequences, walking world (docs/tuning.md, "The label-free
+# route on the walking world"): per camera kind, the sequences, the tuned (sequence, tracker) pairs where tuning on
+# the real labels gained a point or more, the median share of that gain the scene-tuned spec kept on real, and the
+# pairs where it lost more than a point against the defaults.
+TRUST: dict[str, dict] = {}
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One candidate on the fitted scene: its tuned spec (for --tracker), its score a seed (the scene's seeds), their
+    mean and standard deviation, and the defaults' mean on the same seeds."""
+
+    tracker: str
+    spec: str
+    per_seed: tuple[float, ...]
+    default: float
+
+    @property
+    def score(self) -> float:
+        return math.fsum(self.per_seed) / len(self.per_seed)
+
+    @property
+    def spread(self) -> float:
+        return statistics.stdev(self.per_seed) if len(self.per_seed) > 1 else 0.0
+
+
+def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HOTA", trials: int = 20,
+           seeds: Sequence[int] = (0, 1, 2, 3), seed: int = 0, done: Callable[[str], Choice | None] | None = None,
+           finished: Callable[[str, Choice], None] | None = None,
+           say: Callable[[str], None] | None = None) -> list[Choice]:
+    """Each candidate spec tuned on the scene file `scene` (`trials` trials of `seeds`, TPE seeded by `seed`), then
+    run alone on each seed; best first. `done(spec)` gives a candidate finished earlier (a resumed run), `finished`
+    is told each one as it finishes, `say` the progress."""
+    from mtt_sim.lab import tune
+    from mtt_sim.lab.experiment import run_episode
+
+    say = say or (lambda line: None)
+    choices = []
+    for k, spec in enumerate(candidates, 1):
+        choice = done(spec) if done else None
+        if choice is None:
+            say(f"advise: tuning {spec} ({k} of {len(candidates)}), {trials} trials x {len(seeds)} seeds")
+            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed)
+            per_seed = tuple(tune.score(run_episode(scene, result.spec, s), metric) for s in seeds)
+            choice = Choice(spec.partition(":")[0], result.spec, per_seed, float(result.default_value))
+            if finished:
+                finished(spec, choice)
+        choices.append(choice)
+    return sorted(choices, key=lambda c: -c.score)
+
+
+def wins(first: Choice, other: Choice) -> int:
+    """On how many of the scene's seeds `first` scores above `other` (paired: the same episodes)."""
+    return sum(a > b for a, b in zip(first.per_seed, other.per_seed))
+
+
+def table(choices: Sequence[Choice], metric: str) -> str:
+    """The ranking as Markdown: rank, tracker, the tuned score (mean, sd over seeds), the defaults', the seeds on
+    which the first beats it, and the tuned spec."""
+    lines = [f"| rank | tracker | {metric} tuned (mean ± sd over seeds) | {metric} defaults | first wins on | "
+             "tuned spec |", "|---:|---|---:|---:|---:|---|"]
+    for rank, c in enumerate(choices, 1):
+        beaten = "-" if rank == 1 else f"{wins(choices[0], c)} of {len(c.per_seed)} seeds"
+        lines.append(f"| {rank} | {c.tracker} | {100 * c.score:.1f} ± {100 * c.spread:.1f} | {100 * c.default:.1f} | "
+                     f"{beaten} | `{c.spec}` |")
+    return "\n".join(lines)
+
+
+def warnings(choices: Sequence[Choice], camera: str) -> list[str]:
+    """What a user should know before trusting the ranking: a first choice within the seeds' spread of the second
+    (the simulator cannot tell them apart), and the route's record on real cameras of this kind (TRUST)."""
+    out = []
+    if len(choices) > 1:
+        a, b = choices[0], choices[1]
+        if a.score - b.score <= max(a.spread, b.spread) or wins(a, b) < len(a.per_seed):
+            out.append(f"{a.tracker} and {b.tracker} are within the seeds' spread on this scene ({wins(a, b)} of "
+                       f"{len(a.per_seed)} seeds to {a.tracker}): the scene cannot tell them apart; try both")
+    kind = "walking" if camera == "walking" else "still"
+    record = TRUST.get(kind)
+    if record is None:
+        out.append(f"the route has not been measured on real {kind} cameras: check the pick on a few labelled frames "
+                   "where you can")
+    elif record["share"] < 0.5 or record["losing"] > 0:
+        out.append(f"on the shared {kind} cameras ({record['sequences']} MOT15 sequences), specs tuned this way "
+                   f"recovered a median {record['share']:.2f} of the gain that tuning on real labels found, and "
+                   f"{record['losing']} of {record['pairs']} lost more than a point of HOTA against the defaults "
+                   "(docs/tuning.md): check the pick on a few labelled frames where you can")
+    return out
+
+
+def as_dict(choice: Choice) -> dict:
+    """A choice as plain values, with its mean and spread."""
+    return {**asdict(choice), "per_seed": list(choice.per_seed), "score": choice.score, "spread": choice.spread}
