@@ -95,6 +95,8 @@ class Recording:
             raise ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
         self._det = by_frame(det, self.info.length)
         self._gt = by_frame(_gt_table(gt, self.benchmark, gt_file), self.info.length)
+        for array in (*self._det, *self._gt):  # shared by every source `configured` from this one
+            array.flags.writeable = False
         self.has_visibility = gt is not None and gt.shape[1] > 8 and self.benchmark != "MOT15"
         self.has_images = (self.folder / self.info.image_dir).is_dir()
         counts = np.diff(self._det[1])
