@@ -82,3 +82,22 @@ def test_a_worker_parses_what_its_tasks_name_once(counts):
     assert {r["tracker"] for r in records} == {"sort:max_age=3"} and type(records[0]["tracker"]) is str
     assert counts["reads"] == once("a")
     assert counts["parsed"] == {"sort:max_age=3": 1} and counts["built"] == {"sort": 3}
+
+
+def test_parsed_sources_and_specs_cross_processes_as_plain_strings(counts):
+    """What a worker is sent is the string: it reads and parses for itself, and nothing read here is pickled."""
+    import pickle
+
+    from mtt_sim.sources import SourceSpec
+    from mtt_sim.trackers import TrackerSpec
+
+    source, spec = SourceSpec(str(counts["root"] / "a")), TrackerSpec("SORT:max_age=3", canonical=True)
+    source.open()
+    for parsed, text in ((source, str(counts["root"] / "a")), (spec, "sort:max_age=3")):
+        sent = pickle.loads(pickle.dumps(parsed))
+        assert sent == text and type(sent) is str
+
+
+def test_dry_run_reads_the_sequence_once(counts, capsys):
+    assert cli.main(["run", str(counts["root"] / "a"), "--dry-run"]) == 0
+    assert counts["reads"] == once("a") and counts["built"] == {"sort": 1}
