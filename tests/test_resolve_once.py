@@ -101,3 +101,9 @@ def test_parsed_sources_and_specs_cross_processes_as_plain_strings(counts):
 def test_dry_run_reads_the_sequence_once(counts, capsys):
     assert cli.main(["run", str(counts["root"] / "a"), "--dry-run"]) == 0
     assert counts["reads"] == once("a") and counts["built"] == {"sort": 1}
+
+
+def test_tune_reads_its_sequence_once_a_study(counts, capsys):
+    pytest.importorskip("optuna")
+    assert cli.main(["tune", "sort", "--on", str(counts["root"] / "a"), "--trials", "2", "--seeds", "1"]) == 0
+    assert counts["reads"] == once("a")
