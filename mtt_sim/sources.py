@@ -7,6 +7,7 @@ MOTChallenge sequence folder (replayed as recorded, or through the synthetic det
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Mapping, Protocol
@@ -70,29 +71,79 @@ def resolve(name: str | os.PathLike) -> str | Path:
     return scenario.resolve(name)
 
 
-def open_source(what: str | os.PathLike | Scenario, overrides: Mapping | None = None, benchmark: str | None = None,
-                recorded: bool = False) -> Scene | Recording:
+class SourceSpec(str):
+    """A source named once: what the user named, resolved (a shipped key, or the path of a .toml file or sequence
+    folder; a str, so that records, journal keys and worker tasks stay strings) and read on its first `open`, which
+    checks it. Each `open` makes a fresh source (every env its own, with its own obs_mode) from what was read: a
+    sequence's files and a scenario's TOML are read once. Across processes it travels as the plain string, and each
+    process reads it once again. `canonical`: the text is the name resolved (a shipped key as shipped)."""
+
+    def __new__(cls, name: str | os.PathLike, canonical: bool = False) -> SourceSpec:
+        found = resolve(name)
+        self = super().__new__(cls, str(found) if canonical else str(name))
+        self.recorded = isinstance(found, Path) and found.is_dir()
+        self._read = None  # the sequence's Recording, or the scenario's (mapping, where), once read
+        return self
+
+    @classmethod
+    def of(cls, what) -> SourceSpec:
+        """`what` itself if it is one, else what it names."""
+        return what if isinstance(what, SourceSpec) else cls(what)
+
+    def __reduce__(self):
+        return str, (str(self),)
+
+    def open(self, overrides: Mapping | None = None) -> Scene | Recording:
+        """A fresh source configured with `overrides`, as `open_source` opens it."""
+        if self.recorded:
+            from mtt_sim.sim.sensor import twin_sensor
+
+            if self._read is None:
+                from mtt_sim.real.sequence import Recording
+
+                self._read = Recording(str(self))
+            return _replayable(self._read.configured(overrides, twin_sensor), self)
+        from mtt_sim.sim.scene import Scene
+
+        return Scene(self.scenario(overrides))
+
+    def scenario(self, overrides: Mapping | None = None) -> Scenario:
+        """A named scenario's configuration with `overrides`, as `scenario.load` builds it (its TOML read once)."""
+        if self._read is None:
+            self._read = scenario.load_raw(str(self))
+        return scenario.from_raw(copy.deepcopy(self._read[0]), self._read[1], overrides)
+
+
+def open_source(what: str | os.PathLike | Scenario | SourceSpec, overrides: Mapping | None = None,
+                benchmark: str | None = None, recorded: bool = False) -> Scene | Recording:
     """The source `what` names (`recorded`: it must be a sequence folder), configured with `overrides` (nested or
     dotted keys); `benchmark` (MOT15/16/17/20) sets a sequence's scoring rules instead of guessing them from its name
-    and columns."""
+    and columns. A `SourceSpec` opens from what it has read."""
+    if isinstance(what, SourceSpec) and benchmark is None and (what.recorded or not recorded):
+        return what.open(overrides)
     # the sources are imported here, when one is opened: naming one (`resolve`) stays cheap for the command line
     if recorded or (not isinstance(what, Scenario) and is_sequence(what)):
         from mtt_sim.real.sequence import Recording
         from mtt_sim.sim.sensor import twin_sensor
 
-        recording = Recording(what, benchmark, overrides, twin_sensor)
-        if recording.scored and not recording.truth_rows:
-            raise ConfigError(f"{Path(what) / 'gt' / 'gt.txt'}: no rows: nothing to score against, and nobody for a "
-                              "twin to detect (remove the file to replay the sequence unscored)")
-        if recording.config.sensor.model == "recorded" and not recording.detection_rows:
-            det = Path(what) / "det" / "det.txt"
-            raise ConfigError(f"{det}: " + ("no detection rows" if det.is_file() else "not found")
-                              + ": nothing to replay as the sequence's recorded detections; replay its ground truth "
-                                "through the synthetic detector instead (--detector synthetic, sensor.model = "
-                                "'synthetic')")
-        return recording
+        return _replayable(Recording(what, benchmark, overrides, twin_sensor), what)
     if benchmark is not None:
         raise ValueError(f"benchmark={benchmark!r} applies to recorded sequences, not to the scenario {what!r}")
     from mtt_sim.sim.scene import Scene
 
     return Scene(scenario.load(what, overrides))
+
+
+def _replayable(recording: Recording, what) -> Recording:
+    """The recording, if it has what its configuration replays: ground truth where it is scored, detection rows where
+    they are replayed as recorded; a ConfigError saying what to do otherwise."""
+    if recording.scored and not recording.truth_rows:
+        raise ConfigError(f"{Path(what) / 'gt' / 'gt.txt'}: no rows: nothing to score against, and nobody for a "
+                          "twin to detect (remove the file to replay the sequence unscored)")
+    if recording.config.sensor.model == "recorded" and not recording.detection_rows:
+        det = Path(what) / "det" / "det.txt"
+        raise ConfigError(f"{det}: " + ("no detection rows" if det.is_file() else "not found")
+                          + ": nothing to replay as the sequence's recorded detections; replay its ground truth "
+                            "through the synthetic detector instead (--detector synthetic, sensor.model = "
+                            "'synthetic')")
+    return recording

@@ -14,11 +14,11 @@ association, the track table, camera motion, appearance), and one module per tra
 from . import moved
 from .adapters.external import External
 from .adapters.roboflow import SupervisionTracker
-from .base import Param, Tracker, Tracks, available, make, parse_spec, register, split_specs
+from .base import Param, Tracker, TrackerSpec, Tracks, available, make, parse_spec, register, split_specs
 from .registry import BUILT_IN
 
 moved.install()
 __getattr__ = moved.package_attribute
 
-__all__ = ["BUILT_IN", "External", "SupervisionTracker", "Param", "Tracker", "Tracks",
+__all__ = ["BUILT_IN", "External", "SupervisionTracker", "Param", "Tracker", "TrackerSpec", "Tracks",
            "available", "make", "parse_spec", "register", "split_specs"]

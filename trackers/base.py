@@ -344,3 +344,34 @@ def make(spec: str, **params) -> Tracker:
     './mine.py:Mine'); keyword parameters override the spec's."""
     name, spec_params = parse_spec(spec)
     return tracker_class(name)(**{**spec_params, **params})
+
+
+class TrackerSpec(str):
+    """A tracker spec parsed and checked once: the spec's text (a str, so that records, journal keys and worker tasks
+    stay strings), its tracker's `name` and class, and the `params` it gives. Checking builds the tracker once, and
+    that tracker is the first that `make` hands out: none is built only to be thrown away. Across processes it travels
+    as the plain string, and each process parses it once again. `canonical`: the text names a registered tracker as
+    registered ('SORT:max_age=3' -> 'sort:max_age=3')."""
+
+    def __new__(cls, spec: str, canonical: bool = False) -> TrackerSpec:
+        name, params = parse_spec(spec)
+        kind = tracker_class(name)
+        built = kind(**params)
+        if canonical and not plugins.is_location(name):
+            spec, name = built.name + spec.strip()[len(name):], built.name
+        self = super().__new__(cls, spec)
+        self.name, self.kind, self.params, self._built = name, kind, params, built
+        return self
+
+    @classmethod
+    def of(cls, spec: str) -> TrackerSpec:
+        """`spec` itself if it is one, else it parsed."""
+        return spec if isinstance(spec, TrackerSpec) else cls(spec)
+
+    def __reduce__(self):
+        return str, (str(self),)
+
+    def make(self) -> Tracker:
+        """A new tracker of this spec (the first: the one its check built)."""
+        built, self._built = self._built, None
+        return built if built is not None else self.kind(**self.params)

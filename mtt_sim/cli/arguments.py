@@ -116,13 +116,14 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def scenario_key(text: str) -> str:
-    """A scenario as the loader names it (a key, an env id, a .toml file or a sequence folder); a .toml file is read
-    whole here, so that a mistyped key in it is named with the file (not blamed on --config)."""
+    """A scenario as the loader names it (a key, an env id, a .toml file or a sequence folder), as a `SourceSpec` that
+    reads it once; a .toml file is read whole here, so that a mistyped key in it is named with the file (not blamed on
+    --config)."""
     try:
-        found = sources.resolve(text)
-        if isinstance(found, Path) and not found.is_dir():
-            scenario.load(found)
-        return str(found)
+        found = sources.SourceSpec(text, canonical=True)
+        if str(found).endswith(".toml"):
+            found.scenario()
+        return found
     except scenario.ConfigError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
     except (OSError, UnicodeDecodeError) as err:
@@ -138,24 +139,18 @@ def scenario_keys(text: str) -> list[str]:
 
 
 def tracker_specs(text: str) -> list[str]:
-    """Distinct tracker specs, each made once to check its name and parameters."""
+    """Distinct tracker specs, each parsed and checked once (`TrackerSpec`: the tracker its check built is the first
+    its episodes use), a registered tracker named as registered."""
     from mtt_sim import trackers
 
     specs = trackers.split_specs(text)
     if not specs or len(set(specs)) != len(specs):
         raise argparse.ArgumentTypeError(f"{text!r}: expected distinct tracker specs, e.g. sort,iou or "
                                          "'sort:min_hits=1,max_age=5;iou'")
-    canonical = []
-    for spec in specs:
-        try:
-            tracker = trackers.make(spec)
-        except ValueError as err:
-            raise argparse.ArgumentTypeError(str(err)) from None
-        name = trackers.parse_spec(spec)[0]
-        if not trackers.base.plugins.is_location(name):  # a registered one by its name as registered
-            spec = tracker.name + spec.strip()[len(name):]
-        canonical.append(spec)
-    return canonical
+    try:
+        return [trackers.TrackerSpec(spec, canonical=True) for spec in specs]
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def tracker_spec(text: str) -> str:
@@ -296,7 +291,8 @@ def episode_overrides(args) -> dict:
 # ------------------------------------------------------------------ checks of what the arguments name together
 
 def loaded(scenarios: list[str], config: dict, argument: str = "--config", configs=({},)) -> None:
-    """Every scenario loads with the overrides (and each swept value), or a UsageError names the problem."""
+    """Every scenario loads with the overrides (and each swept value), or a UsageError names the problem (a
+    `SourceSpec` keeps what it read for the run)."""
     for sc in scenarios:
         for extra in configs:
             try:
@@ -361,21 +357,24 @@ def add_dry_run(parser: argparse.ArgumentParser) -> None:
 
 def episode_frames(source: str, overrides: dict | None = None, steps: int | None = None) -> int:
     """The frames of one episode of `source` with `overrides`, cheaply: a scenario's env.max_steps (its file read, no
-    world built), a sequence's seqLength (or its length as read), at most `steps`."""
+    world built), a sequence's length as its `SourceSpec` read it (or, named by a plain path, its seqinfo.ini's
+    seqLength), at most `steps`."""
     overrides = overrides or {}
-    if is_sequence(source):
+    if not is_sequence(source):
+        frames = sources.SourceSpec.of(source).scenario(overrides).env.max_steps
+        return frames if steps is None else min(frames, steps)
+    length = source.open(overrides).length if isinstance(source, sources.SourceSpec) else None
+    if length is None:
         ini = configparser.ConfigParser()
         ini.optionxform = str
         try:
             length = int(ini["Sequence"]["seqLength"]) if ini.read(Path(source) / "seqinfo.ini") else None
         except (KeyError, ValueError, configparser.Error):
             length = None
-        if length is None:
-            length = sources.open_source(source, overrides).length
-        limit = scenario.expand_dotted(overrides).get("env", {}).get("max_steps")
-        frames = length if limit is None else min(length, limit)
-    else:
-        frames = scenario.load(source, overrides).env.max_steps
+    if length is None:
+        length = sources.open_source(source, overrides).length
+    limit = scenario.expand_dotted(overrides).get("env", {}).get("max_steps")
+    frames = length if limit is None else min(length, limit)
     return frames if steps is None else min(frames, steps)
 
 

@@ -12,7 +12,7 @@ from mtt_sim.cli.arguments import (CONFIG_HELP, FORCE_HELP, SCENARIO_HELP, Usage
 def add(subparsers) -> None:
     p = subparsers.add_parser("run", help="run one episode with a tracker and print its metrics")
     p.add_argument("scenario", type=scenario_key, help=SCENARIO_HELP)
-    p.add_argument("--tracker", type=tracker_spec, default="sort",
+    p.add_argument("--tracker", type=tracker_spec,  # default: sort, parsed in run() unless --compare stands in
                    help="tracker spec, e.g. sort or 'sort:max_age=3,min_hits=1' (default: sort)")
     p.add_argument("--seed", type=integer(0), default=0, help="episode seed, >= 0 (default 0)")
     p.add_argument("--steps", type=integer(1), default=None, help="at most this many steps (default: the "
@@ -41,7 +41,7 @@ def run(args) -> int:
         raise UsageError("--results", "a results file takes one tracker: leave out --compare")
     if args.scale != 1 and not args.video:
         raise UsageError("--scale", f"{args.scale}: enlarges the video's frames; give --video too")
-    specs = args.compare or [args.tracker]
+    specs = args.compare or [args.tracker or tracker_spec("sort")]
     if dry_run(args, estimate("run", [(len(specs), "trackers"), (1, "seeds")], [args.scenario], overrides,
                               steps=args.steps)):
         return 0
@@ -52,7 +52,7 @@ def run(args) -> int:
                                       progress=True, scale=args.scale, results=args.results)
     for record in records:
         metrics = record["metrics"] or {"metrics": "none: the sequence has no gt/gt.txt"}
-        summary = {"scenario": args.scenario, "tracker": record["tracker"], "seed": args.seed,
+        summary = {"scenario": str(args.scenario), "tracker": record["tracker"], "seed": args.seed,
                    **{k: metrics[k] for k in PRINTED if k in metrics}, **({} if record["metrics"] else metrics),
                    "tracker_fps": record["tracker_fps"], "env_fps": record["env_fps"]}
         if args.json:

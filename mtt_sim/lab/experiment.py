@@ -13,6 +13,7 @@ import csv
 import itertools
 import json
 import math
+import os
 import re
 from pathlib import Path
 from typing import Callable, Iterator, Mapping, Sequence
@@ -30,6 +31,7 @@ from mtt_sim.lab.journal import Journal
 from mtt_sim.env import TrackingEnv
 from mtt_sim.metrics import METRICS, PER_TARGET
 from mtt_sim.real.motchallenge import write_results
+from mtt_sim.sources import SourceSpec
 from mtt_sim.show.video import VideoWriter
 
 BACKENDS = ("local", "ray")
@@ -38,7 +40,7 @@ BACKENDS = ("local", "ray")
 def _episode(scenario: str, spec: str, seed: int, config: Mapping | None, steps: int | None, render: bool,
              scale: int) -> Episode:
     """Tracker `spec` on its own env of `scenario`, reset with `seed` (frames in its observations if it reads them)."""
-    agent = trackers.make(spec)
+    agent = trackers.TrackerSpec.of(spec).make()
     env = TrackingEnv(scenario, config=config, render_mode="rgb_array" if render else None,
                       obs_mode="frame+detections" if agent.needs_frame else "detections", render_scale=scale)
     return Episode(env, seed, agent, steps)
@@ -48,7 +50,7 @@ def _record(run: Episode, spec: str, online: list, scenario: str, seed: int, con
     """The record of tracker `spec`'s finished episode, which reported the tracks `online`."""
     env, frames = run.env, len(online)
     scored = env.scored
-    return {"tracker": spec, "params": run.agent.params, "scenario": str(scenario), "seed": seed,
+    return {"tracker": str(spec), "params": run.agent.params, "scenario": str(scenario), "seed": seed,
             "config": dict(config or {}), "error": None, "metrics": env.metrics.summary() if scored else None,
             "per_target": env.metrics.per_target() if scored else {},
             "tracker_fps": frames / max(run.tracker_time, 1e-9), "env_fps": frames / max(run.env_time, 1e-9)}
@@ -117,12 +119,38 @@ def failed_record(task: tuple, message: str) -> dict:
             "error": message, "metrics": None, "per_target": {}, "tracker_fps": math.nan, "env_fps": math.nan}
 
 
+class _Episodes:
+    """Grid episodes run in one process. A task names its source and tracker spec by strings (what crosses between
+    processes and keys a journal); each is parsed once a process, or taken as the caller already parsed it."""
+
+    def __init__(self, parsed: Sequence = ()):
+        self.sources = {str(p): p for p in parsed if isinstance(p, SourceSpec)}
+        self.specs = {str(p): p for p in parsed if isinstance(p, trackers.TrackerSpec)}
+
+    def __call__(self, task: tuple) -> dict:
+        """One grid episode; an exception in it becomes a failed record with the error's first line."""
+        scenario, spec, *rest = task
+        try:
+            if isinstance(scenario, (str, os.PathLike)):
+                scenario = _once(self.sources, str(scenario), SourceSpec)
+            return run_episode(scenario, _once(self.specs, spec, trackers.TrackerSpec), *rest)
+        except Exception as err:  # noqa: BLE001  (whatever one episode raises, the grid goes on)
+            return failed_record(task, f"{type(err).__name__}: {(str(err).splitlines() or [''])[0]}")
+
+
+def _once(parsed: dict, text: str, kind: type):
+    """`text` parsed as `kind`, the first time it is asked for."""
+    if text not in parsed:
+        parsed[text] = kind(text)
+    return parsed[text]
+
+
+_WORKER = _Episodes()  # a worker process's own: what its tasks name, parsed once
+
+
 def _task(task: tuple) -> dict:
-    """One grid episode; an exception in it becomes a failed record with the error's first line."""
-    try:
-        return run_episode(*task)
-    except Exception as err:  # noqa: BLE001  (whatever one episode raises, the grid goes on)
-        return failed_record(task, f"{type(err).__name__}: {(str(err).splitlines() or [''])[0]}")
+    """One grid episode in a worker process (local or Ray)."""
+    return _WORKER(task)
 
 
 def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequence[int] | int,
@@ -139,20 +167,22 @@ def run_grid(tracker_specs: Sequence[str], scenarios: Sequence[str], seeds: Sequ
     if backend not in BACKENDS:
         raise ValueError(f"backend={backend!r}: allowed values: {', '.join(map(repr, BACKENDS))}")
     seeds = range(seeds) if isinstance(seeds, int) else seeds
-    for spec in tracker_specs:
-        trackers.make(spec)  # fail fast on a bad spec, before any process starts
-    tasks = [(sc, spec, seed, {**(config or {}), **c},
+    specs = [trackers.TrackerSpec.of(spec) for spec in tracker_specs]  # a bad one fails before any process starts
+    tasks = [(str(sc) if isinstance(sc, SourceSpec) else sc, str(spec), seed, {**(config or {}), **c},
               results_path(results_dir, spec, sc, seed if len(seeds) > 1 else None, c) if results_dir else None)
-             for c, sc, spec, seed in itertools.product(configs or [{}], scenarios, tracker_specs, seeds)]
-    return run_tasks(tasks, workers, progress, backend, address, on_record, journal=journal)
+             for c, sc, spec, seed in itertools.product(configs or [{}], scenarios, specs, seeds)]
+    return run_tasks(tasks, workers, progress, backend, address, on_record, journal=journal,
+                     parsed=[*specs, *scenarios])
 
 
 def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, backend: str = "local",
               address: str | None = None, on_record: Callable[[dict], None] | None = None,
-              processes: pool.Pool | None = None, journal: Journal | None = None) -> list[dict]:
+              processes: pool.Pool | None = None, journal: Journal | None = None,
+              parsed: Sequence = ()) -> list[dict]:
     """Episodes (scenario, tracker, seed, config, results file or None) as `run_grid` runs them; records in order.
     `processes` (from `episode_pool`) runs them in workers already started, instead of `workers` new ones. Each
-    finished record goes into `journal`, keyed by its task, and the tasks it already holds are taken from it."""
+    finished record goes into `journal`, keyed by its task, and the tasks it already holds are taken from it.
+    `parsed`: the `SourceSpec`s and `TrackerSpec`s the tasks name, as the caller parsed them (for episodes run here)."""
     records: list = [None] * len(tasks)
     keys = [repr(task) for task in tasks]
     kept = [i for i, key in enumerate(keys) if journal is not None and key in journal]
@@ -162,7 +192,8 @@ def run_tasks(tasks: Sequence[tuple], workers: int = 1, progress: bool = False, 
             records[i] = journal.get(keys[i])
             if on_record:
                 on_record(records[i])
-        for j, record in _finished([tasks[i] for i in missing], workers, backend, address, processes):
+        for j, record in _finished([tasks[i] for i in missing], workers, backend, address, processes,
+                                   _Episodes(parsed)):
             i = missing[j]
             records[i] = record
             if journal is not None:
@@ -191,14 +222,14 @@ def episode_pool(workers: int) -> pool.Pool:
     return pool.Pool(_task, workers)
 
 
-def _finished(tasks: list, workers: int, backend: str, address: str | None,
-              processes: pool.Pool | None = None) -> Iterator[tuple[int, dict]]:
-    """(index, record) of every task as it finishes."""
+def _finished(tasks: list, workers: int, backend: str, address: str | None, processes: pool.Pool | None,
+              here: _Episodes) -> Iterator[tuple[int, dict]]:
+    """(index, record) of every task as it finishes (run by `here` where they run in this process)."""
     if backend == "ray":
         yield from _on_ray(tasks, workers, address)
     elif processes is None and workers <= 1:
         for i, task in enumerate(tasks):
-            yield i, _task(task)
+            yield i, here(task)
     else:
         done = processes.run(tasks) if processes is not None else pool.run(_task, tasks, workers)
         for i, value in done:

@@ -123,7 +123,8 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
             for step, source in enumerate(sources):
                 tasks = [(source, trial_spec, s, dict(config or {}), None) for s in seeds]
                 with interrupts.allowed():  # the episodes: the one place Ctrl-C stops at once
-                    records = run_tasks(tasks, workers, backend=backend, address=address, processes=processes)
+                    records = run_tasks(tasks, workers, backend=backend, address=address, processes=processes,
+                                        parsed=sources)  # a SourceSpec (the command line's) read once a study
                 failed = [r["error"] for r in records if r["error"]]
                 if failed:
                     trial.set_user_attr("error", failed[0])

@@ -20,6 +20,7 @@ simulator: its types and configuration tables live below both sources, in `mtt_s
 from __future__ import annotations
 
 import configparser
+import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Mapping
@@ -94,6 +95,8 @@ class Recording:
             raise ConfigError(f"benchmark={self.benchmark!r}: allowed values: {', '.join(map(repr, BENCHMARKS))}")
         self._det = by_frame(det, self.info.length)
         self._gt = by_frame(_gt_table(gt, self.benchmark, gt_file), self.info.length)
+        for array in (*self._det, *self._gt):  # shared by every source `configured` from this one
+            array.flags.writeable = False
         self.has_visibility = gt is not None and gt.shape[1] > 8 and self.benchmark != "MOT15"
         self.has_images = (self.folder / self.info.image_dir).is_dir()
         counts = np.diff(self._det[1])
@@ -101,9 +104,20 @@ class Recording:
         self.detection_rows = len(det)  # none: nothing to replay as recorded (open_source refuses it)
         self.truth_rows = 0 if gt is None else len(gt)  # none in a gt.txt: nothing to score (refused where scored)
         self.det_range = (det[:, 2:7].min(axis=0), det[:, 2:7].max(axis=0)) if len(det) else (np.zeros(5), np.zeros(5))
-        self.config = self._configure(overrides or {})
         self.image_size = (self.info.width, self.info.height)
         self.frame_rate, self.length = self.info.frame_rate, self.info.length
+        self._start(overrides, twin)
+
+    def configured(self, overrides: Mapping | None = None, twin: Twin | None = None) -> Recording:
+        """A fresh source over the same sequence, its files not read again: this one's arrays shared (nothing writes
+        them), configured anew with `overrides` (an env's own obs_mode, say) and `twin`."""
+        new = copy.copy(self)
+        new._start(overrides, twin)
+        return new
+
+    def _start(self, overrides: Mapping | None, twin: Twin | None) -> None:
+        """Configured with `overrides` and `twin`, at the first frame."""
+        self.config = self._configure(overrides or {})
         if self.config.sensor.model == "synthetic" and twin is None:
             raise ConfigError(f"{self.folder}: sensor.model = 'synthetic' replays the ground truth through the "
                               "simulator's detector: open the sequence with mtt_sim.sources.open_source, or pass "

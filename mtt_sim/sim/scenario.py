@@ -197,6 +197,12 @@ def load(key_or_path: str | Path | Scenario, overrides: Mapping | None = None) -
         raw, where = to_mapping(key_or_path), f"scenario {key_or_path.name}"
     else:
         raw, where = load_raw(key_or_path)
+    return from_raw(raw, where, overrides)
+
+
+def from_raw(raw: Mapping, where: str, overrides: Mapping | None = None) -> Scenario:
+    """The scenario of a mapping `load_raw` read (from `where`), with optional overrides: `load` without the file read,
+    for a source that is opened again and again (`mtt_sim.sources.SourceSpec`)."""
     if overrides:
         if not isinstance(overrides, Mapping):
             raise ConfigError(f"config overrides must be a mapping, got {type(overrides).__name__}")
