@@ -13,7 +13,7 @@ from pathlib import Path
 from mtt_sim.cli import resuming
 from mtt_sim.cli.arguments import (FORCE_HELP, UsageError, add_dry_run, announce, check_sensor, dry_run, estimate,
                                    integer, output_file, parse_seeds, replaced, tracker_specs)
-from mtt_sim.cli.fit_scene import detections_folder
+from mtt_sim.cli.fit_scene import add_camera
 from mtt_sim.cli.tune import metric_goals
 
 
@@ -22,9 +22,7 @@ def add(subparsers) -> None:
 
     p = subparsers.add_parser("advise", help="for a camera without labels: fit its scene, tune each candidate tracker "
                                              "on it and rank them, with the tuned specs and the simulator's confidence")
-    p.add_argument("folder", type=detections_folder, metavar="DIR", help="a sequence folder with det/det.txt")
-    p.add_argument("--sensor", required=True, metavar="FILE",
-                   help="the detector: a [sensor] table, e.g. from mtt-sim calibrate on other, labelled sequences")
+    add_camera(p)
     p.add_argument("--trackers", type=tracker_specs, default=list(CANDIDATES),
                    help=f"the candidates, each tuned from its spec (default {','.join(CANDIDATES)})")
     p.add_argument("--metric", type=metric_goals, default="HOTA", help="what to rank by and tune for (default HOTA)")

@@ -22,12 +22,17 @@ def detections_folder(text: str) -> str:
     return text
 
 
-def add(subparsers) -> None:
-    p = subparsers.add_parser("fit-scene", help="fit a scene to a sequence's detections alone (no labels): print its "
-                                                "statistics beside the scene's and write the scene")
+def add_camera(p) -> None:
+    """The camera without labels (DIR) and the detector its scene is seen through (--sensor)."""
     p.add_argument("folder", type=detections_folder, metavar="DIR", help="a sequence folder with det/det.txt")
     p.add_argument("--sensor", required=True, metavar="FILE",
                    help="the detector: a [sensor] table, e.g. from mtt-sim calibrate on other, labelled sequences")
+
+
+def add(subparsers) -> None:
+    p = subparsers.add_parser("fit-scene", help="fit a scene to a sequence's detections alone (no labels): print its "
+                                                "statistics beside the scene's and write the scene")
+    add_camera(p)
     p.add_argument("--out", required=True, help="the scenario to write (.toml)")
     p.add_argument("--seeds", type=integer(1), default=2, help="scene runs averaged in the check (default 2)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
