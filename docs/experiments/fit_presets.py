@@ -10,6 +10,7 @@ or as near as the shift can bring it (poor boxes, IoU 0.3 to 0.5 with the person
     python docs/experiments/fit_presets.py          # writes mtt_sim/core/detectors/{dpm,frcnn,sdp}.toml, prints the fit
 """
 
+import sys
 from pathlib import Path
 
 from scipy.special import expit, logit
@@ -37,6 +38,8 @@ def mot17_like_ap(sensor: dict) -> float:
 def main():
     base = {k: v for k, v in scenario.PRESETS["mot15_frcnn"].items()}
     for name, target in PUBLISHED_AP.items():
+        if sys.argv[1:] and name not in sys.argv[1:]:
+            continue
         lo, hi = -4.0, 6.0
         for _ in range(12):
             mid = (lo + hi) / 2
