@@ -103,7 +103,8 @@ def test_dry_run_reads_the_sequence_once(counts, capsys):
     assert counts["reads"] == once("a") and counts["built"] == {"sort": 1}
 
 
-def test_tune_reads_its_sequence_once_a_study(counts, capsys):
+def test_tune_reads_its_sequence_and_parses_its_spec_once_a_study(counts, capsys):
     pytest.importorskip("optuna")
     assert cli.main(["tune", "sort", "--on", str(counts["root"] / "a"), "--trials", "2", "--seeds", "1"]) == 0
     assert counts["reads"] == once("a")
+    assert counts["parsed"]["sort"] == 1  # the study's spec, parsed once for its definition, name and space

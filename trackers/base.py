@@ -361,6 +361,7 @@ class TrackerSpec(str):
             spec, name = built.name + spec.strip()[len(name):], built.name
         self = super().__new__(cls, spec)
         self.name, self.kind, self.params, self._built = name, kind, params, built
+        self.registered, self.values = built.name, dict(built.params)  # as registered; every value, defaults filled
         return self
 
     @classmethod

@@ -17,9 +17,8 @@ import socket
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
-from mtt_sim import trackers
 from mtt_sim.metrics.goals import Goal, goals
-from mtt_sim.trackers.base import parse_spec, plugins, search_space, spec_of
+from mtt_sim.trackers.base import TrackerSpec, plugins, search_space, spec_of
 
 
 def definition(spec: str, sources: Sequence[str], metric: str = "HOTA", seeds: Sequence[int] = (0,),
@@ -27,11 +26,11 @@ def definition(spec: str, sources: Sequence[str], metric: str = "HOTA", seeds: S
     """What defines a study, as stored with it, and its digest (8 hex digits): everything that changes a trial's
     value or what is searched. The tracker with its fixed parameters, the sources (a TOML file with its content's
     digest), the metrics with their directions, the seeds, the overrides (dotted keys) and the search space."""
-    name, fixed = parse_spec(spec)
-    tracker = trackers.make(spec)
+    spec = TrackerSpec.of(spec)
+    name, fixed = spec.name, spec.params
     space = search_space(name, fixed)
-    canonical = name if plugins.is_location(name) else tracker.name
-    out = {"tracker": spec_of(canonical, {k: tracker.params[k] for k in sorted(fixed)}),
+    canonical = name if plugins.is_location(name) else spec.registered
+    out = {"tracker": spec_of(canonical, {k: spec.values[k] for k in sorted(fixed)}),
            "sources": [_source(s) for s in sources],
            "metric": ", ".join(("maximize " if g.maximize else "minimize ") + g.metric for g in goals(metric)),
            "seeds": sorted(int(s) for s in seeds),
@@ -44,8 +43,8 @@ def definition(spec: str, sources: Sequence[str], metric: str = "HOTA", seeds: S
 
 def default_study_name(spec: str, sources: Sequence[str], metric: str, digest: str) -> str:
     """'sort on crossing for HOTA (1a2b3c4d)': the tracker, the sources, the metrics and the definition's digest."""
-    name = parse_spec(spec)[0]
-    tracker = name if plugins.is_location(name) else trackers.make(spec).name
+    spec = TrackerSpec.of(spec)
+    tracker = spec.name if plugins.is_location(spec.name) else spec.registered
     return f"{tracker} on {','.join(map(str, sources))} for {','.join(g.text for g in goals(metric))} ({digest})"
 
 

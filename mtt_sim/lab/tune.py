@@ -27,13 +27,12 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
-from mtt_sim import trackers
 from mtt_sim.lab.experiment import episode_pool, run_tasks
 from mtt_sim.lab.study import (counted, default_study_name, definition, mark_interrupted, open_storage, open_study,
                                state)
 from mtt_sim.metrics.goals import Goal, goals
 from mtt_sim.sim.scenario import to_toml
-from mtt_sim.trackers.base import parse_spec, search_space, spec_of
+from mtt_sim.trackers.base import TrackerSpec, search_space, spec_of
 
 
 @dataclass
@@ -98,11 +97,11 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
     Returns the result and the Optuna study; on Ctrl-C raises `Interrupted` with the best so far."""
     import optuna
 
-    name, fixed = parse_spec(spec)
-    tracker = trackers.make(spec)  # a bad spec fails here, before any episode
+    spec = TrackerSpec.of(spec)  # a bad spec fails here, before any episode; parsed once for the whole study
+    name, fixed = spec.name, spec.params
     space = search_space(name, fixed)
     if not space:
-        raise ValueError(f"tracker {tracker.name!r} has no tunable parameter left to search (fixed in the spec: "
+        raise ValueError(f"tracker {spec.registered!r} has no tunable parameter left to search (fixed in the spec: "
                          f"{', '.join(fixed) or 'none'})")
     wanted = goals(metric)
     defined, digest = definition(spec, sources, metric, seeds, config)
@@ -113,7 +112,7 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
     interrupts = _Interrupts()
     with interrupts.held():
         study, kept = open_study(store, study_name or own_name, own_name, defined, digest, wanted, trials,
-                                 {k: tracker.params[k] for k in space}, say, _sampler(0, 0))
+                                 {k: spec.values[k] for k in space}, say, _sampler(0, 0))
 
         def objective(trial):
             params = {k: p.suggest(trial, k) for k, p in space.items()}
