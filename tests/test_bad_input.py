@@ -148,6 +148,11 @@ BAD_INPUTS = [
      r"argument DIR: \S*/fewcols/det/det.txt: row 1 has 5 values"),  # the folder given, no scratch one
     (["fit-scene", "OK", "--sensor", "SENSOR", "--out", "s.txt"], r"argument --out: 's.txt': the file name must end in"),
     (["fit-scene", "nowhere", "--sensor", "SENSOR", "--out", "s.toml"], r"argument DIR: 'nowhere' is not a sequence "),
+    # advise
+    (["advise", "OK", "--sensor", "BADSENSOR"], r"argument --sensor: \S*badsensor.toml: unknown key sensor.pdd"),
+    (["advise", "OK", "--sensor", "SENSOR", "--trackers", "sort,sortt"], r"unknown tracker 'sortt' \(did you mean"),
+    (["advise", "OK", "--sensor", "SENSOR", "--out", "a.txt"], r"argument --out: 'a.txt': the file name must end in"),
+    (["advise", "OK", "--sensor", "SENSOR", "--resume"], r"argument --resume: needs --out"),
     # learn-policy
     (["learn-policy", "--on", "crossing", "--sigma", "-1"], r"argument --sigma: must be a number > 0, got '-1'"),
     (["learn-policy", "--on", "crossing", "--sigma", "0"], r"argument --sigma: must be a number > 0, got '0'"),
@@ -273,6 +278,8 @@ DRY_RUNS = [
       "--seeds", "1"], "learn-policy: 2 generations x 4 policies x 1 source x 1 seed = 8 episodes, about 40 frames"),
     (["fit-scene", "OK", "--sensor", "SENSOR", "--out", "s.toml"],
      "fit-scene: 3 runs (the sequence linked, then the scene's seeds) = 3 episodes, about 15 frames"),
+    (["advise", "OK", "--sensor", "SENSOR", "--trackers", "sort,iou", "--trials", "3", "--seeds", "2"],
+     "advise: 2 trackers x 4 runs x 2 seeds = 16 episodes, about 80 frames, after the scene's fit"),
     (["perf", "--repeats", "2", "--sections", "env,jpda"], "perf: 2 tables x 2 repeats = 4 measurements"),
     (["learn-reid", "--seeds", "2", "--frames", "30"], "learn-reid: 2 seeds = 2 episodes, about 60 frames"),
     (["export", "crossing", "--out", "seq", "--steps", "7"], "export: 1 episode, about 7 frames"),
