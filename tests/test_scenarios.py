@@ -143,7 +143,7 @@ def test_mot17_like_has_mot17_scene_statistics():
 def test_a_variant_is_its_base_with_its_own_keys(tmp_path):
     moving = load("mot17_moving")
     assert moving.render.camera == "walking" and moving.world.size == (2400.0, 540.0)
-    assert moving.sensor == load("mot17_like").sensor and moving.groups[0].count == 24
+    assert moving.sensor == load("mot17_like").sensor and moving.groups[0].count == 38
     (tmp_path / "loop.toml").write_text(f'base = "{tmp_path / "loop.toml"}"\n')
     with pytest.raises(ConfigError, match="without a cycle"):
         load(tmp_path / "loop.toml")
