@@ -98,14 +98,22 @@ class SourceSpec(str):
         if self.recorded:
             from mtt_sim.sim.sensor import twin_sensor
 
-            if self._read is None:
-                from mtt_sim.real.sequence import Recording
-
-                self._read = Recording(str(self))
-            return _replayable(self._read.configured(overrides, twin_sensor), self)
+            return _replayable(self._recording().configured(overrides, twin_sensor), self)
         from mtt_sim.sim.scene import Scene
 
         return Scene(self.scenario(overrides))
+
+    def _recording(self) -> Recording:
+        """The recorded sequence as read, once."""
+        if self._read is None:
+            from mtt_sim.real.sequence import Recording
+
+            self._read = Recording(str(self))
+        return self._read
+
+    def length(self) -> int:
+        """A recorded sequence's frames, whatever it would be replayed through (what it holds is not checked)."""
+        return self._recording().length
 
     def scenario(self, overrides: Mapping | None = None) -> Scenario:
         """A named scenario's configuration with `overrides`, as `scenario.load` builds it (its TOML read once)."""

@@ -2,6 +2,7 @@
 statistics are known, a bad trace named by its row, and the command on a tiny sequence and trace."""
 
 import json
+import shutil
 import tomllib
 
 import numpy as np
@@ -92,6 +93,14 @@ def test_the_command_prints_people_and_cameras_side_by_side(tmp_path, capsys):
     assert cli.main(["motion", "mot17_moving", "crossing", "--steps", "60", "--json"]) == 0
     cameras = json.loads(capsys.readouterr().out)["cameras"]  # a scene's own camera, from its warps
     assert cameras["crossing"]["translation p95 (px)"] == 0 and cameras["mot17_moving"]["translation median (px)"] > 0.5
+
+
+def test_a_sequence_with_ground_truth_alone_is_measured(tmp_path, capsys):
+    gt = [(f, 1, 100.0 + 2 * f, 200.0, 20.0, 50.0, 1, 1, 1.0) for f in range(1, 41)]
+    folder = write_sequence(tmp_path / "gt_only", gt=gt, size=(400, 300))
+    shutil.rmtree(folder / "det")  # as the shared MOT17 ground truths come: no detections
+    assert cli.main(["motion", str(folder), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["people"]["gt_only"]["speed"] == pytest.approx(0.4)
 
 
 def test_the_walking_model_fitted_to_its_own_walkers_shows_their_statistics_again():

@@ -363,7 +363,7 @@ def episode_frames(source: str, overrides: dict | None = None, steps: int | None
     if not is_sequence(source):
         frames = sources.SourceSpec.of(source).scenario(overrides).env.max_steps
         return frames if steps is None else min(frames, steps)
-    length = source.open(overrides).length if isinstance(source, sources.SourceSpec) else None
+    length = source.length() if isinstance(source, sources.SourceSpec) else None
     if length is None:
         ini = configparser.ConfigParser()
         ini.optionxform = str
