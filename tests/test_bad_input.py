@@ -11,7 +11,7 @@ import pytest
 from mtt_sim import cli
 from mtt_sim.env import TrackingEnv
 
-from helpers import write_sequence
+from helpers import exit_code, write_sequence
 
 DET = [(f, 10.0 + f, 10.0, 20.0, 40.0, 0.9) for f in range(1, 6)]
 GT = [(f, 1, 10.0 + f, 10.0, 20.0, 40.0, 1, 1, 1.0) for f in range(1, 6)]
@@ -232,18 +232,12 @@ def no_episode(monkeypatch):
     monkeypatch.setattr(TrackingEnv, "reset", refuse)
 
 
-def _main(argv) -> int:
-    try:
-        return cli.main(argv)
-    except SystemExit as done:  # argparse's own checks
-        return done.code
-
 
 @pytest.mark.parametrize("argv, pattern", BAD_INPUTS, ids=[" ".join(a) for a, _ in BAD_INPUTS])
 def test_a_bad_input_is_refused_in_one_line_naming_it_before_any_work(argv, pattern, inputs, no_episode, capsys,
                                                                       tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    code = _main(_argv(argv, inputs))
+    code = exit_code(_argv(argv, inputs))
     err = capsys.readouterr().err
     assert code == 2 and re.search(pattern, err), err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
@@ -296,7 +290,7 @@ DRY_RUNS = [
 def test_dry_run_checks_estimates_and_writes_nothing(argv, estimate, inputs, no_episode, capsys, tmp_path,
                                                      monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert _main([*_argv(argv, inputs), "--dry-run"]) == 0
+    assert exit_code([*_argv(argv, inputs), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert out.strip() == estimate or re.fullmatch(estimate, out.strip()), out
     assert not list(tmp_path.iterdir())
@@ -307,7 +301,7 @@ def test_dry_run_checks_estimates_and_writes_nothing(argv, estimate, inputs, no_
                          ids=lambda argv: argv[0])
 def test_a_dry_run_refuses_what_a_run_refuses(argv, inputs, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert _main([*_argv(argv, inputs), "--dry-run"]) == 2 and not capsys.readouterr().out
+    assert exit_code([*_argv(argv, inputs), "--dry-run"]) == 2 and not capsys.readouterr().out
 
 
 def test_check_real_dry_run_counts_the_sequences(inputs, tmp_path, capsys):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import mtt_sim  # noqa: F401  (registers the env ids)
-from helpers import write_sequence
+from helpers import exit_code, write_sequence
 from mtt_sim import cli
 from mtt_sim.sim2real import calibrate
 from mtt_sim.lab.export import export_episode
@@ -145,10 +145,7 @@ def test_calibration_arguments_get_one_line_errors(twin, tmp_path, capsys, argv,
     (tmp_path / "bad.toml").write_text("[env]\nmax_steps = 3\n")
     (tmp_path / "nomodel.toml").write_text("[sensor]\npd = 0.5\n")
     argv = [a.format(empty=tmp_path / "empty", tmp=tmp_path, twin=twin) for a in argv]
-    try:
-        code = cli.main(argv)
-    except SystemExit as done:  # argparse's own checks
-        code = done.code
+    code = exit_code(argv)
     err = capsys.readouterr().err
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
 

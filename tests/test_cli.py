@@ -12,6 +12,7 @@ import sys
 import cv2
 import pytest
 
+from helpers import exit_code
 from mtt_sim import trackers
 from mtt_sim import cli
 from mtt_sim.cli import arguments
@@ -139,10 +140,7 @@ BAD_ARGUMENTS = [
 @pytest.mark.parametrize("argv, pattern", BAD_ARGUMENTS)
 def test_a_bad_argument_gets_one_line_and_exit_two_before_any_work(argv, pattern, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    try:
-        code = cli.main(argv)
-    except SystemExit as done:  # argparse's own checks
-        code = done.code
+    code = exit_code(argv)
     err = capsys.readouterr().err
     assert code == 2 and re.search(pattern, err), err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 
+from helpers import exit_code
 from mtt_sim import cli
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -121,10 +122,7 @@ def test_a_documented_command_runs_as_written(argv, command, tmp_path, monkeypat
         if entry.name not in (".git", ".venv"):
             (tmp_path / entry.name).symlink_to(entry)
     monkeypatch.chdir(tmp_path)
-    try:
-        code = cli.main(argv if argv[0] in INSTANT else [*argv, "--dry-run"])
-    except SystemExit as done:
-        code = done.code
+    code = exit_code(argv if argv[0] in INSTANT else [*argv, "--dry-run"])
     captured = capsys.readouterr()
     assert code == 0, f"{command}\n{captured.err}"
     assert sorted(os.listdir(tmp_path)) == sorted(e.name for e in ROOT.iterdir() if e.name not in (".git", ".venv"))

@@ -6,6 +6,7 @@ import json
 
 import pytest
 
+from helpers import exit_code
 from mtt_sim import cli
 from mtt_sim.lab import stress
 from mtt_sim.lab.experiment import run_episode
@@ -118,13 +119,7 @@ def test_the_command_prints_json_worst_first_and_refuses_bad_keys(tmp_path, caps
                           (["--vary", "render.camera=static|pan"], "needs a static or shaking camera"),
                           (["--vary", "groups.5.count=1:3"], "no such item"),
                           (["--vary", "sensor.pd=0:1", "--objective", "MOTA[sort] - MOTAX"], "unknown metric 'MOTAX'")]:
-        assert _status(["stress", "sort", "--scenario", "crossing", *argv]) == 2
+        assert exit_code(["stress", "sort", "--scenario", "crossing", *argv]) == 2
         assert message in capsys.readouterr().err
 
 
-def _status(argv: list[str]) -> int:
-    """The command's exit status, whether argparse exits or the command returns."""
-    try:
-        return cli.main(argv)
-    except SystemExit as exit_:
-        return exit_.code
