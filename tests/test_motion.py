@@ -109,8 +109,8 @@ def test_the_walking_model_fitted_to_its_own_walkers_shows_their_statistics_agai
     frames = fit_walkers.simulate(truth, RATE, people=120, duration=30.0, seed=5)
     fitted = fit_walkers.fit([(frames, RATE)], frame_rate=RATE)
     assert fitted.model == "langevin" and fitted.stop_rate > 0 and fitted.go_rate > 0
-    again = fit_walkers._statistics([motion.window_values(fit_walkers.simulate(fitted, RATE, seed=6), RATE)])
-    wanted = fit_walkers._statistics([motion.window_values(frames, RATE)])
+    again = fit_walkers.statistics([motion.window_values(fit_walkers.simulate(fitted, RATE, seed=6), RATE)])
+    wanted = fit_walkers.statistics([motion.window_values(frames, RATE)])
     assert again[:3] == pytest.approx(wanted[:3], rel=0.2) and again[3] == pytest.approx(wanted[3], abs=0.05)
 
 

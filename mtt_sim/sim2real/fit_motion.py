@@ -37,12 +37,10 @@ then fits each model to its share:
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import asdict, replace
 
 import numpy as np
-from scipy.optimize import minimize
 
 from mtt_sim.sim import camera as cam
 from mtt_sim.sim import scenario as scn
@@ -176,21 +174,13 @@ def fit_walkers(frames, frame_rate: float, seed: int = 0) -> WalkConfig:
         base = replace(base, **_rates_from_share(frames, frame_rate))
     if len(values["deviation"]) < MIN_WINDOWS:  # too short to read the relaxation and the noise: the shipped ones
         return base
-    target = _statistics(values)
+    target = walkers_fit.statistics([values])
 
     def with_(relax: float, walk_noise: float, speed: float) -> WalkConfig:
         return replace(base, relax=float(np.clip(relax, 0.01, 100.0)), noise=float(np.clip(walk_noise, 0.0, 10.0)),
                        speed=float(np.clip(speed, 0.0, 10.0)))
 
-    def miss(x) -> float:
-        sim = walkers_fit.simulate(with_(*np.exp(x)), frame_rate, SIM_PEOPLE, SIM_SECONDS, seed)
-        got = _statistics(window_values(sim, frame_rate))
-        return float(np.sum(np.log(np.maximum(got, 1e-3) / np.maximum(target, 1e-3)) ** 2))
-
-    start = min(itertools.product(walkers_fit.RELAX, walkers_fit.NOISE), key=lambda rn: miss(np.log([*rn, base.speed])))
-    found = minimize(miss, np.log([*start, base.speed]), method="Nelder-Mead",
-                     options={"xatol": 0.02, "fatol": 1e-4, "maxfev": 120})
-    return with_(*np.exp(found.x))
+    return with_(*walkers_fit.search(with_, base.speed, target, frame_rate, SIM_PEOPLE, SIM_SECONDS, seed))
 
 
 def _rates_from_share(frames, frame_rate: float) -> dict:
@@ -203,13 +193,6 @@ def _rates_from_share(frames, frame_rate: float) -> dict:
     standing = float(np.mean(np.concatenate(per_track) < STANDING))
     go = 1.0 / (2.0 * max(1.0, float(np.median([len(s) for s in per_track]))))
     return {"go_rate": round(go, 4), "stop_rate": round(min(go * standing / max(1 - standing, 0.05), 100.0), 4)}
-
-
-def _statistics(values: dict) -> np.ndarray:
-    """What the walkers are matched on: the median speed, deviation and turn, and the standing share."""
-    med = lambda v: float(np.median(v)) if len(v) else 0.0  # noqa: E731
-    return np.array([med(values["speed"]), med(values["deviation"]), med(values["turning"]),
-                     float(np.mean(values["speed"] < STANDING)) if len(values["speed"]) else 0.0])
 
 
 def fit(rows: np.ndarray, info) -> dict:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import replace
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 from scipy.optimize import minimize
@@ -81,24 +81,34 @@ def fit(sources: Iterable[tuple[list, float]], frame_rate: float = 25.0) -> Walk
     """The walking model fitted to (frames, frame rate) sources of real scored ground truth, for scenes at
     `frame_rate` frames per second."""
     sources = list(sources)
-    target = _statistics([window_values(frames, rate) for frames, rate in sources])
+    target = statistics([window_values(frames, rate) for frames, rate in sources])
     base = replace(WalkConfig(model="langevin"), **direct(sources))
 
     def with_(relax: float, noise: float, speed: float) -> WalkConfig:
         return replace(base, relax=float(relax), noise=float(noise), speed=float(speed))
 
+    return with_(*np.round(search(with_, base.speed, target, frame_rate), 4))
+
+
+def search(with_: Callable[[float, float, float], WalkConfig], speed: float, target: np.ndarray, frame_rate: float,
+           people: int = 150, duration: float = 20.0, seed: int = 0) -> np.ndarray:
+    """The relaxation, noise and desired speed whose walkers (`with_` of them, `simulate`d) best show `target`
+    (`statistics`), in the least squares of the logarithms: the best point of the RELAX x NOISE grid at the desired
+    speed `speed`, refined with the speed by Nelder-Mead."""
     def miss(x) -> float:
-        got = _statistics([window_values(simulate(with_(*np.exp(x)), frame_rate), frame_rate)])
+        got = statistics([window_values(simulate(with_(*np.exp(x)), frame_rate, people, duration, seed), frame_rate)])
         return float(np.sum(np.log(np.maximum(got, 1e-3) / np.maximum(target, 1e-3)) ** 2))
 
-    start = min(itertools.product(RELAX, NOISE), key=lambda rn: miss(np.log([*rn, base.speed])))
-    found = minimize(miss, np.log([*start, base.speed]), method="Nelder-Mead",
+    start = min(itertools.product(RELAX, NOISE), key=lambda rn: miss(np.log([*rn, speed])))
+    found = minimize(miss, np.log([*start, speed]), method="Nelder-Mead",
                      options={"xatol": 0.02, "fatol": 1e-4, "maxfev": 120})
-    return with_(*np.round(np.exp(found.x), 4))
+    return np.exp(found.x)
 
 
-def _statistics(values: list[dict]) -> np.ndarray:
-    """What the grid matches: the median speed, deviation and turn, and the standing share, over every window."""
+def statistics(values: list[dict]) -> np.ndarray:
+    """What the walkers are matched on: the median speed, deviation and turn, and the standing share, over every
+    window of `values` (`motion.window_values` of each source; 0 where there is none)."""
     joined = {k: np.concatenate([v[k] for v in values]) for k in ("speed", "deviation", "turning")}
-    return np.array([np.median(joined["speed"]), np.median(joined["deviation"]), np.median(joined["turning"]),
-                     np.mean(joined["speed"] < STANDING)])
+    med = lambda v: float(np.median(v)) if len(v) else 0.0  # noqa: E731
+    return np.array([med(joined["speed"]), med(joined["deviation"]), med(joined["turning"]),
+                     float(np.mean(joined["speed"] < STANDING)) if len(joined["speed"]) else 0.0])
