@@ -59,6 +59,7 @@ def run(args) -> int:
                   "seed": args.seed}
     journal = resuming.journal(out, definition, args.resume, "candidates") if out else None
     say = (lambda line: print(line, file=sys.stderr, flush=True))
+    path = scene_file or Path(out or ".").with_name(f".advise_{Path(args.folder).name}_scene.toml")
     try:
         text = journal.get("scene", None) if journal else None
         if text is None:
@@ -66,7 +67,6 @@ def run(args) -> int:
             text = fit_scene.fit_scene(args.folder, args.sensor, seeds=())[3]
             if journal:
                 journal.put("scene", text)
-        path = scene_file or Path(out or ".").with_name(f".advise_{Path(args.folder).name}_scene.toml")
         path.write_text(text)
         choices = advise.advise(str(path), args.trackers, args.metric, args.trials, args.seeds, args.seed,
                                 done=(lambda spec: journal.get(("tracker", spec), None)) if journal else None,
@@ -77,7 +77,7 @@ def run(args) -> int:
             return resuming.stopped("advise", journal, "the scene and the candidates tuned")
         raise
     finally:
-        if not scene_file and "path" in locals():
+        if not scene_file:
             path.unlink(missing_ok=True)
     camera = tomllib.loads(text).get("render", {}).get("camera", "still")
     report = _report(args, choices, camera)

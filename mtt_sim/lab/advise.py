@@ -50,6 +50,7 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
     is told each one as it finishes, `say` the progress."""
     from mtt_sim.lab import tune
     from mtt_sim.lab.experiment import run_episode
+    from mtt_sim.trackers import TrackerSpec
 
     say = say or (lambda line: None)
     choices = []
@@ -59,7 +60,7 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
             say(f"advise: tuning {spec} ({k} of {len(candidates)}), {trials} trials x {len(seeds)} seeds")
             result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed)
             per_seed = tuple(tune.score(run_episode(scene, result.spec, s), metric) for s in seeds)
-            choice = Choice(spec.partition(":")[0], result.spec, per_seed, float(result.default_value))
+            choice = Choice(TrackerSpec.of(spec).registered, result.spec, per_seed, float(result.default_value))
             if finished:
                 finished(spec, choice)
         choices.append(choice)
