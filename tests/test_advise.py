@@ -6,7 +6,7 @@ import pytest
 
 from helpers import exit_code, write_sequence
 from mtt_sim import cli, trackers
-from mtt_sim.lab import advise
+from mtt_sim.lab import advise, routes
 
 FRAMES = 25
 
@@ -77,12 +77,12 @@ def test_two_trackers_the_seeds_cannot_tell_apart_are_said_to_be():
 
 def test_the_routes_record_on_real_cameras_of_the_kind_is_told(monkeypatch):
     a, c = advise.Choice("sort", "sort", (0.50, 0.40), 0.45), advise.Choice("iou", "iou", (0.10, 0.11), 0.10)
-    monkeypatch.setattr(advise, "TRUST", {})
-    assert advise.warnings([a, c], "walking") == ["the route has not been measured on real walking cameras: check "
-                                                  "the pick on a few labelled frames where you can"]
-    monkeypatch.setattr(advise, "TRUST", {"still": {"sequences": 6, "losing": 1, "pairs": 12, "share": 0.4}})
-    assert "recovered a median 0.40" in advise.warnings([a, c], "still")[0]
-    monkeypatch.setattr(advise, "TRUST", {"still": {"sequences": 6, "losing": 0, "pairs": 12, "share": 0.8}})
+    monkeypatch.setattr(routes, "RECORD", {})
+    assert advise.warnings([a, c], "walking") == [routes.caution("scene", "walking")]
+    assert "not been measured" in advise.warnings([a, c], "walking")[0]
+    monkeypatch.setattr(routes, "RECORD", {("scene", "still"): routes.Record(6, 12, 8, 0.4, 1)})
+    assert "kept a median 0.40" in advise.warnings([a, c], "still")[0]
+    monkeypatch.setattr(routes, "RECORD", {("scene", "still"): routes.Record(6, 12, 8, 0.8, 0)})
     assert advise.warnings([a, c], "still") == []  # a route that held on real cameras of the kind is not doubted
 
 

@@ -8,6 +8,7 @@ share of the oracle's gain each route recovers, and which tracker each route wou
     python docs/experiments/tune_sim_to_real.py ../shared/data/mot15 OUT.jsonl --trackers sort,bytetrack --trials 30
     python docs/experiments/tune_sim_to_real.py ../shared/data/mot15 OUT.jsonl --trackers jpda --trials 20 \
         --seeds 4 --frames 400
+    python docs/experiments/tune_sim_to_real.py ../shared/data/mot15 OUT.jsonl --record   # RECORD for lab/routes.py
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pathlib import Path
 
 from mtt_sim.env import TrackingEnv
 from mtt_sim.lab.experiment import run_episode
+from mtt_sim.lab.routes import records
 from mtt_sim.lab.tune import tune
 from mtt_sim.sim2real.calibrate import calibrate, to_toml
 from mtt_sim.sim2real.fit_scene import fit_scene
@@ -41,11 +43,17 @@ def main() -> None:
     p.add_argument("--frames", type=int, default=0,
                    help="fewer seeds for long sequences: about this many frames a trial (0: always --seeds)")
     p.add_argument("--table", action="store_true", help="only print the table of the rows in OUT")
+    p.add_argument("--record", action="store_true",
+                   help="only print the routes' record of the rows in OUT, for mtt_sim/lab/routes.py's RECORD")
     args = p.parse_args()
     out = Path(args.out)
+    rows = [json.loads(line) for line in _lines(out)] if args.table or args.record else None
+    if args.record:
+        print(record(rows, out.with_suffix("")))
+        return
     if not args.table:
         measure(args, out)
-    print(table([json.loads(line) for line in out.read_text().splitlines()], args.metric))
+    print(table(rows or [json.loads(line) for line in out.read_text().splitlines()], args.metric))
 
 
 def measure(args, out: Path) -> None:
@@ -101,6 +109,16 @@ def _lines(path: Path) -> list[str]:
 
 def _real(folder: Path, spec: str, metric: str) -> float:
     return run_episode(str(folder), spec)["metrics"][metric]
+
+
+def record(rows: list[dict], work: Path) -> str:
+    """The routes' record of `rows` as RECORD's Python text: the scene's per the camera kind its fit found (the scene
+    files in `work`)."""
+    kinds = {}
+    for r in rows:
+        camera = tomllib.loads((work / f"scene_{r['sequence']}.toml").read_text())["render"]["camera"]
+        kinds[r["sequence"]] = "walking" if camera == "walking" else "still"
+    return "RECORD = {\n" + "".join(f"    {key!r}: {value!r},\n" for key, value in records(rows, kinds).items()) + "}"
 
 
 def table(rows: list[dict], metric: str) -> str:

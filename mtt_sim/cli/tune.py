@@ -74,6 +74,7 @@ def run(args) -> int:
     if dry_run(args, work):
         return 0
     announce(work)
+    _caution(args.on, overrides)
     from mtt_sim.lab import tune
 
     try:
@@ -107,6 +108,15 @@ def run(args) -> int:
               + _resume(args, result.study), file=sys.stderr)
         return INTERRUPTED
     return 0
+
+
+def _caution(sources: list[str], overrides: dict) -> None:
+    """Warn, once per route, where tuning in simulation has not held on real video (`routes.RECORD`)."""
+    from mtt_sim.lab import routes
+
+    taken = {routes.route_of(source, overrides) for source in sources} - {None}
+    for line in sorted(filter(None, {routes.caution(*route) for route in taken})):
+        print(f"mtt-sim tune: warning: {line}", file=sys.stderr)
 
 
 def _resume(args, study: str) -> str:

@@ -2,9 +2,9 @@
 (`fit_scene`), tune each candidate tracker on it (`tune`) and rank them by the tuned score, with the simulator's
 confidence: each tuned spec's spread over the scene's seeds and how often the first beats the others seed by seed.
 
-What the ranking is worth on real video is measured, not assumed: TRUST holds the figures of the label-free route on
-the shared MOT15 sequences (docs/tuning.md), per kind of camera, and `warnings` turns them into the lines a user of a
-camera of that kind should read before trusting the ranking.
+What the ranking is worth on real video is measured, not assumed: `routes.RECORD` holds the label-free route's figures
+on the shared MOT15 sequences (docs/tuning.md), per kind of camera, and `warnings` adds the line a user of a camera of
+that kind should read before trusting the ranking.
 """
 
 from __future__ import annotations
@@ -14,12 +14,9 @@ import statistics
 from dataclasses import asdict, dataclass
 from typing import Callable, Sequence
 
+from mtt_sim.lab import routes
+
 CANDIDATES = ("sort", "bytetrack", "ocsort", "iou", "gmphd")  # fast and sound on every shared sequence
-# The label-free route measured on the eight shared MOT15 sequences, walking world (docs/tuning.md, "The label-free
-# route on the walking world"): per camera kind, the sequences, the tuned (sequence, tracker) pairs where tuning on
-# the real labels gained a point or more, the median share of that gain the scene-tuned spec kept on real, and the
-# pairs where it lost more than a point against the defaults.
-TRUST: dict[str, dict] = {}
 
 
 @dataclass(frozen=True)
@@ -86,23 +83,16 @@ def table(choices: Sequence[Choice], metric: str) -> str:
 
 def warnings(choices: Sequence[Choice], camera: str) -> list[str]:
     """What a user should know before trusting the ranking: a first choice within the seeds' spread of the second
-    (the simulator cannot tell them apart), and the route's record on real cameras of this kind (TRUST)."""
+    (the simulator cannot tell them apart), and the route's record on real cameras of this kind (`routes.RECORD`)."""
     out = []
     if len(choices) > 1:
         a, b = choices[0], choices[1]
         if a.score - b.score <= max(a.spread, b.spread) or wins(a, b) < len(a.per_seed):
             out.append(f"{a.tracker} and {b.tracker} are within the seeds' spread on this scene ({wins(a, b)} of "
                        f"{len(a.per_seed)} seeds to {a.tracker}): the scene cannot tell them apart; try both")
-    kind = "walking" if camera == "walking" else "still"
-    record = TRUST.get(kind)
-    if record is None:
-        out.append(f"the route has not been measured on real {kind} cameras: check the pick on a few labelled frames "
-                   "where you can")
-    elif record["share"] < 0.5 or record["losing"] > 0:
-        out.append(f"on the shared {kind} cameras ({record['sequences']} MOT15 sequences), specs tuned this way "
-                   f"recovered a median {record['share']:.2f} of the gain that tuning on real labels found, and "
-                   f"{record['losing']} of {record['pairs']} lost more than a point of HOTA against the defaults "
-                   "(docs/tuning.md): check the pick on a few labelled frames where you can")
+    line = routes.caution("scene", "walking" if camera == "walking" else "still")
+    if line:
+        out.append(line)
     return out
 
 

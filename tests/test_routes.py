@@ -1,0 +1,67 @@
+"""The simulated tuning routes' record on real video: which route a source takes, the warning a user reads, and the
+record computed from hand-made rows."""
+
+import pytest
+
+from helpers import write_sequence
+from mtt_sim import cli
+from mtt_sim.lab import routes
+
+
+@pytest.fixture
+def sources(tmp_path):
+    folder = write_sequence(tmp_path / "seq", [(1, 10.0, 10.0, 20.0, 40.0, 0.9)])
+    still, walking, other = tmp_path / "still.toml", tmp_path / "walking.toml", tmp_path / "mine.toml"
+    still.write_text(f'{routes.FITTED_HEADER}: a scene\nname = "A"\n[render]\ncamera = "still"\n')
+    walking.write_text(f'{routes.FITTED_HEADER}: a scene\nname = "B"\n[render]\ncamera = "walking"\n')
+    other.write_text('name = "Mine"\n')
+    return folder, still, walking, other
+
+
+def test_each_source_takes_its_route(sources):
+    folder, still, walking, other = sources
+    assert routes.route_of(str(folder)) is None  # the sequence's own labels: nothing simulated
+    assert routes.route_of(str(folder), {"sensor.model": "synthetic"}) == ("twin", routes.ANY)
+    assert routes.route_of(str(still)) == ("scene", "still")
+    assert routes.route_of(str(walking)) == ("scene", "walking")
+    assert routes.route_of(str(other)) == ("generic", routes.ANY)
+    assert routes.route_of("mot17_like") == ("generic", routes.ANY)
+
+
+def test_a_route_is_doubted_unless_its_record_held(monkeypatch):
+    monkeypatch.setattr(routes, "RECORD", {})
+    assert "has not been measured" in routes.caution("twin", routes.ANY)
+    monkeypatch.setattr(routes, "RECORD", {("twin", routes.ANY): routes.Record(8, 16, 10, 0.7, 0),
+                                           ("generic", routes.ANY): routes.Record(8, 16, 10, 0.7, 3),
+                                           ("scene", "walking"): routes.Record(2, 4, 3, 0.3, 0),
+                                           ("scene", "still"): routes.Record(6, 12, 0, None, 1)})
+    assert routes.caution("twin", routes.ANY) is None
+    assert routes.caution("generic", routes.ANY).startswith("on the shared sequences (8 MOT15 sequences), specs tuned "
+                                                            "on the generic kept a median 0.70")
+    assert " 3 of 16 lost more than a point of HOTA" in routes.caution("generic", routes.ANY)
+    assert "kept a median 0.30" in routes.caution("scene", "walking")
+    assert "scene: 1 of 12 lost" in routes.caution("scene", "still")
+
+
+def test_the_record_is_computed_from_the_rows():
+    def row(sequence, tracker, route, real, defaults=0.40):
+        return {"sequence": sequence, "tracker": tracker, "route": route, "defaults": defaults, "real": real}
+
+    rows = [row("A", "sort", "oracle", 0.50), row("A", "sort", "scene", 0.45), row("A", "sort", "twin", 0.48),
+            row("B", "sort", "oracle", 0.405), row("B", "sort", "scene", 0.38), row("B", "sort", "twin", 0.40),
+            row("C", "sort", "oracle", 0.60), row("C", "sort", "scene", 0.42), row("C", "sort", "twin", 0.30)]
+    got = routes.records(rows, {"A": "still", "B": "still", "C": "walking"})
+    # A gains 10 points on its labels, the scene keeps 5 of them; B's labels gain half a point (no share), and its
+    # scene loses 2 points; C's scene keeps 2 of 20; the twin keeps 8 of 10 on A and loses 10 on C (-0.5 of 20)
+    assert got[("scene", "still")] == routes.Record(sequences=2, pairs=2, gaining=1, share=0.5, losing=1)
+    assert got[("scene", "walking")] == routes.Record(sequences=1, pairs=1, gaining=1, share=0.1, losing=0)
+    assert got[("twin", routes.ANY)] == routes.Record(sequences=3, pairs=3, gaining=2, share=0.15, losing=1)
+
+
+def test_tune_warns_once_per_route_that_did_not_hold(monkeypatch, capsys):
+    monkeypatch.setattr(routes, "RECORD", {("generic", routes.ANY): routes.Record(8, 16, 10, 0.2, 5)})
+    assert cli.main(["tune", "sort", "--on", "crossing,books", "--trials", "2", "--json",
+                     "--config", "env.max_steps=10"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs tuned on the generic kept a median "
+                     "0.20") == 1
