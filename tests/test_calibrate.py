@@ -14,6 +14,8 @@ from mtt_sim.sim2real import calibrate
 from mtt_sim.lab.export import export_episode
 from mtt_sim.sim import scenario
 from mtt_sim.sim2real import validate
+from mtt_sim.sim2real.fit_scene import fit_scene
+from mtt_sim.lab.experiment import run_episode
 from mtt_sim.env import NO_TRACKS
 from mtt_sim.core.frame import Truth
 
@@ -171,6 +173,18 @@ def test_validate_compares_real_and_twin_metrics_for_every_twin(two_sequences):
     assert g[3] == pytest.approx(by_hand)
     text = validate.markdown(v)
     assert "| Seq0 | sort |" in text and "memoryless, on the others" in text and "P(miss | miss)" in text
+
+
+def test_validate_judges_the_label_free_fitted_scene_as_its_own_run_would(two_sequences, tmp_path, capsys):
+    v = validate.validate(two_sequences, ("sort",), seeds=1, scene=True)
+    assert {k[0] for k in v.twin} == {t.name for t in validate.TWINS + (validate.SCENE,)} and not v.failed
+    # by hand: Seq0's scene, fitted to its detections with the detector fitted on Seq1, and SORT on its seed 0
+    others = calibrate.fit(calibrate.pooled([calibrate.read(two_sequences[1]).associated]))
+    scene = tmp_path / "scene.toml"
+    scene.write_text(fit_scene(two_sequences[0], others, seeds=())[3])
+    assert v.twin[validate.SCENE.name, "Seq0", "sort"]["MOTA"] == run_episode(str(scene), "sort", 0)["metrics"]["MOTA"]
+    argv = ["validate", *map(str, two_sequences), "--trackers", "sort", "--seeds", "1", "--scene", "--dry-run"]
+    assert cli.main(argv) == 0 and "1 real, 5 twins x 1 seeds" in capsys.readouterr().out
 
 
 def test_kendall_tau_of_identical_rankings_is_one_and_of_reversed_minus_one():

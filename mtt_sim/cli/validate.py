@@ -15,6 +15,9 @@ def add(subparsers) -> None:
                    help="tracker specs (default: sort,iou,bytetrack,gnn,gmphd,lmb:reid=false,jpda)")
     p.add_argument("--seeds", type=integer(1), default=3, help="twin episodes per sequence and tracker (default 3)")
     p.add_argument("--workers", type=integer(1), default=1, help="parallel processes (default 1)")
+    p.add_argument("--scene", action="store_true",
+                   help="also judge each sequence's label-free fitted scene (fit-scene on its detections alone, the "
+                        "detector fitted on the others): what a camera without labels predicts of the trackers")
     p.add_argument("--out", help="also write the tables to this Markdown file (.md)")
     p.add_argument("--force", action="store_true", help=FORCE_HELP)
     add_dry_run(p)
@@ -27,15 +30,16 @@ def run(args) -> int:
     from mtt_sim.sim2real import validate
 
     specs = args.trackers or validate.TRACKERS
-    twins = [t for t in validate.TWINS if len(args.folders) > 1 or not t.leave_one_out]
+    twins = [t for t in validate.TWINS + ((validate.SCENE,) if args.scene else ())
+             if len(args.folders) > 1 or not t.leave_one_out]
     runs = (len(args.folders), "sequences"), (len(specs), "trackers"), (1 + len(twins) * args.seeds, "runs (1 real, "
                                                                          f"{len(twins)} twins x {args.seeds} seeds)")
     work = estimate("validate", runs, args.folders)
     if dry_run(args, work):
         return 0
     announce(work)
-    result = validate.validate(args.folders, specs, seeds=args.seeds, workers=args.workers,
-                               progress=True)
+    result = validate.validate(args.folders, specs, seeds=args.seeds, workers=args.workers, progress=True,
+                               scene=args.scene)
     text = validate.markdown(result)
     print(text)
     if out:

@@ -193,8 +193,11 @@ def _camel(name: str) -> str:
 
 
 def with_sensor(raw: dict, sensor) -> dict:
-    """The scene with the [sensor] table of a sensor file (none: the schema's default detector)."""
-    return {**raw, **scn.read_sensor(sensor)} if sensor is not None else raw
+    """The scene with the [sensor] table of a sensor file, or with a mapping of sensor keys (none: the schema's
+    default detector)."""
+    if sensor is None:
+        return raw
+    return {**raw, **(scn.read_sensor(sensor) if isinstance(sensor, (str, Path)) else {"sensor": dict(sensor)})}
 
 
 def scene_statistics(raw: dict, seeds=(0, 1)) -> dict:
@@ -218,8 +221,9 @@ def _scene_tracklets(raw: dict, seed: int) -> np.ndarray:
 
 
 def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[dict, dict, dict, str]:
-    """Fit a scene to a sequence folder's detections: (the scene as a mapping with the sensor merged in, the
-    sequence's statistics, the scene's statistics over `seeds`, the TOML text with its header)."""
+    """Fit a scene to a sequence folder's detections, with the detector `sensor` (a sensor file or a mapping of sensor
+    keys): (the scene as a mapping with the sensor merged in, the sequence's statistics, the scene's statistics over
+    `seeds`, the TOML text with its header)."""
     rows, info = link_sequence(folder)
     if not len(rows):
         raise scn.ConfigError(f"{folder}: no tracklets of {MIN_FRAMES} frames or more in its det/det.txt to fit a "
@@ -234,7 +238,8 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
     header = [f"mtt-sim fit-scene: a scene fitted to the detections of {Path(folder).name} alone",
               f"({info.length} frames at {info.frame_rate:g} fps; {len(np.unique(rows[:, 1]))} tracklets of at least "
               f"{MIN_FRAMES} frames linked by {LINKER}).",
-              "Detector: " + (f"the [sensor] table of {Path(sensor).name}." if sensor is not None else "the default."),
+              "Detector: " + ("the default." if sensor is None else f"the [sensor] table of {Path(sensor).name}."
+                              if isinstance(sensor, (str, Path)) else "the one given."),
               f"Motion: walkers by walk.model = \"langevin\" at {info.frame_rate:g} fps; a {raw['render']['camera']} "
               "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "") + ".",
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]

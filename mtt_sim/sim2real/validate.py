@@ -6,11 +6,14 @@ on the other sequences only (leave one out); and the same with the memoryless de
 drawn independently at the fitted rates), so that what memory buys is measured in one run. The answer: per sequence
 and tracker MOTA, IDF1 and IDSW, real against each twin; per detector the median absolute gaps and the mean Kendall
 tau between the real and the twin rankings of the trackers; the twin's detector statistics against the data's.
+With `scene`, each sequence's label-free fitted scene (`fit_scene` on its detections alone, the detector fitted on the
+others) is judged the same way: what a camera without labels would predict of the trackers.
 """
 
 from __future__ import annotations
 
 import math
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -31,15 +34,18 @@ GOALS = {"MOTA": 3.0, "IDF1": 5.0, "tau": 0.7, "detector": 0.10}  # points, poin
 
 @dataclass(frozen=True)
 class Twin:
-    """One way of making a sequence's twin: which sequences the detector is fitted on, and with memory or not."""
+    """One way of making a sequence's twin: which sequences the detector is fitted on, with memory or not, and
+    whether the people are the sequence's own or its fitted scene's (label-free)."""
 
     name: str
     leave_one_out: bool
     memory: bool
+    scene: bool = False
 
 
 TWINS = (Twin("fitted here", False, True), Twin("fitted on the others", True, True),
          Twin("memoryless, fitted here", False, False), Twin("memoryless, on the others", True, False))
+SCENE = Twin("fitted scene, on the others", True, True, scene=True)
 
 
 @dataclass(frozen=True)
@@ -57,26 +63,31 @@ class Validation:
 
 
 def validate(folders: Sequence[str | Path], tracker_specs: Sequence[str] = TRACKERS, seeds: int = 3, workers: int = 1,
-             progress: bool = False) -> Validation:
-    """Run the check (see the module docstring). Leave-one-out twins need two sequences or more."""
+             progress: bool = False, scene: bool = False) -> Validation:
+    """Run the check (see the module docstring). Leave-one-out twins and the fitted scene need two sequences or
+    more."""
     sources = [calibrate.read(f) for f in folders]
     names = tuple(Path(f).name for f in folders)
-    twins = tuple(t for t in TWINS if len(sources) > 1 or not t.leave_one_out)
+    twins = tuple(t for t in TWINS + ((SCENE,) if scene else ()) if len(sources) > 1 or not t.leave_one_out)
     here = [calibrate.fit(src.associated) for src in sources]
     others = [calibrate.fit(calibrate.pooled([o.associated for j, o in enumerate(sources) if j != i]))
               if len(sources) > 1 else None for i in range(len(sources))]
     sensors = {(t.name, i): {**(others[i] if t.leave_one_out else here[i]), "memory": t.memory}
                for t in twins for i in range(len(sources))}
-    tasks, keys = [], []
-    for i, folder in enumerate(folders):
-        for spec in tracker_specs:
-            tasks.append((str(folder), spec, 0, {}, None))
-            keys.append(("real", names[i], spec))
-            for t in twins:
-                for seed in range(seeds):
-                    tasks.append((str(folder), spec, seed, {"sensor": sensors[t.name, i]}, None))
-                    keys.append((t.name, names[i], spec))
-    records = experiment.run_tasks(tasks, workers, progress)
+    with tempfile.TemporaryDirectory() as work:
+        scenes = {i: _fitted_scene(folder, others[i], Path(work)) for i, folder in enumerate(folders)
+                  if any(t.scene for t in twins)}
+        tasks, keys = [], []
+        for i, folder in enumerate(folders):
+            for spec in tracker_specs:
+                tasks.append((str(folder), spec, 0, {}, None))
+                keys.append(("real", names[i], spec))
+                for t in twins:
+                    for seed in range(seeds):
+                        tasks.append((scenes[i], spec, seed, {}, None) if t.scene else
+                                     (str(folder), spec, seed, {"sensor": sensors[t.name, i]}, None))
+                        keys.append((t.name, names[i], spec))
+        records = experiment.run_tasks(tasks, workers, progress)
     real, twin, failed, values = {}, {}, [], {}
     for key, r in zip(keys, records):
         if r["error"]:
@@ -96,6 +107,15 @@ def validate(folders: Sequence[str | Path], tracker_specs: Sequence[str] = TRACK
             if not t.leave_one_out:
                 detector[names[i], t.name] = calibrate.twin_statistics([src], sensors[t.name, i], seeds)
     return Validation(names, tuple(tracker_specs), twins, real, twin, detector, seeds, tuple(failed))
+
+
+def _fitted_scene(folder, sensor: dict, work: Path) -> str:
+    """The label-free scene of `folder` with the detector `sensor`, written in `work`; its path."""
+    from mtt_sim.sim2real.fit_scene import fit_scene
+
+    path = work / f"scene_{Path(folder).name}.toml"
+    path.write_text(fit_scene(folder, sensor, seeds=())[3])
+    return str(path)
 
 
 # ------------------------------------------------------------------ what the check says
