@@ -1,8 +1,10 @@
 """Train the shipped `learned` policy: CMA-ES from SORT's rules on synthetic scenes and twins only.
 
-Training episodes (seeds 1000 and up, away from the judging seeds 0..9): `mot17_like` with each detector preset
-(frcnn, dpm, sdp), and the twins of the two MOT17 training sequences whose ground truth is shared (MOT17-02 through
-the dpm preset, MOT17-09 through frcnn). No MOT15 sequence, real or twin, is seen: those judge.
+Training episodes (seeds 1000 and up, away from the judging seeds 0..9), all with the walking world's people (they
+stop, wait and walk on): `mot17_like` (a still camera) with each detector preset (frcnn, dpm, sdp) and on the slower
+clocks of real cameras (14 and 7 frames a second), `mot17_moving` (a walking camera) with the frcnn and dpm presets,
+and the twins of the two MOT17 training sequences whose ground truth is shared (MOT17-02 through the dpm preset,
+MOT17-09 through frcnn). No MOT15 sequence, real or twin, is seen: those judge.
 
     python docs/experiments/train_policy.py ../shared/data OUT_FOLDER --generations 15 --workers 2
 """
@@ -19,6 +21,10 @@ from mtt_sim.lab.plots import learning_curve
 from mtt_sim.learn.policy_search import learn_policy, replays
 
 PRESETS = ("frcnn", "dpm", "sdp")
+SCENES = [("mot17_like", {"sensor.preset": p}) for p in PRESETS] + [
+    ("mot17_like", {"sensor.preset": "dpm", "world.frame_rate": 14.0}),
+    ("mot17_like", {"sensor.preset": "frcnn", "world.frame_rate": 7.0}),
+    *(("mot17_moving", {"sensor.preset": p}) for p in ("frcnn", "dpm"))]
 TWINS = {"MOT17-02-DPM": "dpm", "MOT17-09-FRCNN": "frcnn"}
 
 
@@ -36,8 +42,8 @@ def main() -> None:
     out = Path(args.out)
     start = time.perf_counter()
     seeds = range(1000, 1000 + args.seeds)
-    episodes = [e for preset in PRESETS
-                for e in replays(["mot17_like"], seeds, out / f"mot17_like-{preset}", {"sensor.preset": preset},
+    episodes = [e for scene, config in SCENES
+                for e in replays([scene], seeds, out / "-".join([scene, *map(str, config.values())]), config,
                                  args.frames)]
     episodes += [e for name, preset in TWINS.items()
                  for e in replays([str(Path(args.data) / "mot17" / name)], [1000], out / f"twin-{name}",
@@ -46,8 +52,9 @@ def main() -> None:
                             workers=args.workers, progress=True, base=args.base)
     minutes = (time.perf_counter() - start) / 60
     save_policy(out / f"policy_{args.base}.npz", learning.weights, base=args.base,
-                trained_on="mot17_like with the frcnn, dpm and sdp presets (seeds 1000-1001, 200 frames); twins of "
-                           "MOT17-02 (dpm) and MOT17-09 (frcnn), 200 frames",
+                trained_on=f"{'; '.join(f'{scene} {config}' for scene, config in SCENES)} (seeds "
+                           f"{seeds.start}-{seeds.stop - 1}, {args.frames} frames); twins of MOT17-02 (dpm) and "
+                           f"MOT17-09 (frcnn), {args.frames} frames",
                 method=f"CMA-ES from SORT's rules, {args.generations} generations of {args.population}, seed 0, "
                        "fitness the mean of MOTA and HOTA")
     learning_curve(learning, out / "learning_curve.png")
