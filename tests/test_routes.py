@@ -33,14 +33,16 @@ def test_a_route_is_doubted_unless_its_record_held(monkeypatch):
     assert "has not been measured" in routes.caution("twin", routes.ANY)
     monkeypatch.setattr(routes, "RECORD", {("twin", routes.ANY): routes.Record(8, 16, 10, 0.7, 0),
                                            ("generic", routes.ANY): routes.Record(8, 16, 10, 0.7, 3),
-                                           ("scene", "walking"): routes.Record(2, 4, 3, 0.3, 0),
+                                           ("scene", "walking"): routes.Record(2, 4, 3, -0.3, 0),
                                            ("scene", "still"): routes.Record(6, 12, 0, None, 1)})
     assert routes.caution("twin", routes.ANY) is None
     assert routes.caution("generic", routes.ANY).startswith("on the shared sequences (8 MOT15 sequences), specs tuned "
-                                                            "on the generic kept a median 0.70")
+                                                            "on a generic scenario kept a median 0.70")
     assert " 3 of 16 lost more than a point of HOTA" in routes.caution("generic", routes.ANY)
-    assert "kept a median 0.30" in routes.caution("scene", "walking")
-    assert "scene: 1 of 12 lost" in routes.caution("scene", "still")
+    assert "kept a median -0.30" in routes.caution("scene", "walking")
+    assert routes.caution("scene", "walking").endswith("the defaults did better there; prefer them unless a few "
+                                                       "labelled frames say otherwise")
+    assert "fitted scene: 1 of 12 lost" in routes.caution("scene", "still")
 
 
 def test_the_record_is_computed_from_the_rows():
@@ -63,5 +65,5 @@ def test_tune_warns_once_per_route_that_did_not_hold(monkeypatch, capsys):
     assert cli.main(["tune", "sort", "--on", "crossing,books", "--trials", "2", "--json",
                      "--config", "env.max_steps=10"]) == 0
     err = capsys.readouterr().err
-    assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs tuned on the generic kept a median "
-                     "0.20") == 1
+    assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs tuned on a generic scenario kept a "
+                     "median 0.20") == 1

@@ -118,7 +118,8 @@ def record(rows: list[dict], work: Path) -> str:
     for r in rows:
         camera = tomllib.loads((work / f"scene_{r['sequence']}.toml").read_text())["render"]["camera"]
         kinds[r["sequence"]] = "walking" if camera == "walking" else "still"
-    return "RECORD = {\n" + "".join(f"    {key!r}: {value!r},\n" for key, value in records(rows, kinds).items()) + "}"
+    return "RECORD = {\n" + "".join(f'    ("{route}", "{kind}"): {value!r},\n'
+                                     for (route, kind), value in records(rows, kinds).items()) + "}"
 
 
 def table(rows: list[dict], metric: str) -> str:
