@@ -79,3 +79,31 @@ def test_clipped_boxes_lie_inside_the_image(rows):
     b = np.array(rows, float).reshape(-1, 4) * 3 - (150, 150, 0, 0)  # positions anywhere, sizes positive
     c = clip_boxes(b, 200, 100)
     assert (c >= 0).all() and (c[:, 0] + c[:, 2] <= 200).all() and (c[:, 1] + c[:, 3] <= 100).all()
+
+
+def test_pieces_labelled_within_the_visible_box_are_those_of_the_whole_region():
+    """`pieces_of` labels only the visible pixels' bounding box; the whole region's labels (the brute force) give the
+    same pieces in the same order, for regions cut at random by ellipses and rectangles."""
+    import cv2
+
+    from mtt_sim.sim.truth import pieces_of
+
+    rng, compared = np.random.default_rng(0), 0
+    for _ in range(400):
+        h, w = (int(v) for v in rng.integers(8, 300, 2))
+        mask = np.zeros((h, w), np.uint8)
+        for _ in range(rng.integers(1, 6)):
+            centre = (int(rng.integers(0, w)), int(rng.integers(0, h)))
+            cv2.ellipse(mask, centre, (int(rng.integers(1, 40)), int(rng.integers(1, 80))), 0, 0, 360, 255, -1)
+        for _ in range(rng.integers(0, 5)):
+            x, y = int(rng.integers(0, w)), int(rng.integers(0, h))
+            cv2.rectangle(mask, (x, y), (x + int(rng.integers(1, 40)), y + int(rng.integers(1, 60))), 0, -1)
+        seen = cv2.countNonZero(mask)
+        if not seen:
+            continue
+        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        big = stats[1:, cv2.CC_STAT_AREA] >= max(4, 0.05 * seen)
+        whole = stats[1:][big][:, :4] if count > 2 and big.sum() >= 2 else np.zeros((0, 4), np.int32)
+        np.testing.assert_array_equal(pieces_of(mask, seen, cv2.boundingRect(mask)), whole)
+        compared += len(whole) >= 2
+    assert compared > 50  # many regions did fall into pieces
