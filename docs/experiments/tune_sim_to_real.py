@@ -21,7 +21,7 @@ from pathlib import Path
 
 from mtt_sim.env import TrackingEnv
 from mtt_sim.lab.experiment import run_episode
-from mtt_sim.lab.routes import records
+from mtt_sim.lab.routes import camera_kind, records
 from mtt_sim.lab.tune import tune
 from mtt_sim.sim2real.calibrate import calibrate, to_toml
 from mtt_sim.sim2real.fit_scene import fit_scene
@@ -114,10 +114,7 @@ def _real(folder: Path, spec: str, metric: str) -> float:
 def record(rows: list[dict], work: Path) -> str:
     """The routes' record of `rows` as RECORD's Python text: the scene's per the camera kind its fit found (the scene
     files in `work`)."""
-    kinds = {}
-    for r in rows:
-        camera = tomllib.loads((work / f"scene_{r['sequence']}.toml").read_text())["render"]["camera"]
-        kinds[r["sequence"]] = "walking" if camera == "walking" else "still"
+    kinds = {r["sequence"]: camera_kind((work / f"scene_{r['sequence']}.toml").read_text()) for r in rows}
     return "RECORD = {\n" + "".join(f'    ("{route}", "{kind}"): {value!r},\n'
                                      for (route, kind), value in records(rows, kinds).items()) + "}"
 

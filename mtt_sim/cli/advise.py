@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 import shlex
 import sys
-import tomllib
 from pathlib import Path
 
 from mtt_sim.cli import resuming
@@ -51,7 +50,7 @@ def run(args) -> int:
     if dry_run(args, work + ", after the scene's fit"):
         return 0
     announce(work)
-    from mtt_sim.lab import advise
+    from mtt_sim.lab import advise, routes
     from mtt_sim.sim2real import fit_scene
 
     definition = {"folder": str(Path(args.folder).resolve()), "sensor": Path(args.sensor).read_text(),
@@ -79,7 +78,7 @@ def run(args) -> int:
     finally:
         if not scene_file:
             path.unlink(missing_ok=True)
-    camera = tomllib.loads(text).get("render", {}).get("camera", "still")
+    camera = routes.camera_kind(text)
     report = _report(args, choices, camera)
     if out:
         out.write_text(report + "\n")

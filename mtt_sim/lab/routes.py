@@ -60,9 +60,13 @@ def route_of(source: str, overrides: Mapping[str, object] | None = None) -> tupl
     if path.suffix == ".toml" and path.is_file():
         text = path.read_text()
         if text.startswith(FITTED_HEADER):
-            camera = tomllib.loads(text).get("render", {}).get("camera", "still")
-            return "scene", "walking" if camera == "walking" else "still"
+            return "scene", camera_kind(text)
     return "generic", ANY
+
+
+def camera_kind(scene: str) -> str:
+    """The kind of camera ("walking" or "still") of a fit-scene file's text: what its fit found."""
+    return "walking" if tomllib.loads(scene).get("render", {}).get("camera") == "walking" else "still"
 
 
 def caution(route: str, kind: str) -> str | None:

@@ -75,8 +75,8 @@ def validate(folders: Sequence[str | Path], tracker_specs: Sequence[str] = TRACK
     sensors = {(t.name, i): {**(others[i] if t.leave_one_out else here[i]), "memory": t.memory}
                for t in twins for i in range(len(sources))}
     with tempfile.TemporaryDirectory() as work:
-        scenes = {i: _fitted_scene(folder, others[i], Path(work)) for i, folder in enumerate(folders)
-                  if any(t.scene for t in twins)}
+        scenes = {i: _fitted_scene(folder, sensors[t.name, i], Path(work)) for t in twins if t.scene
+                  for i, folder in enumerate(folders)}
         tasks, keys = [], []
         for i, folder in enumerate(folders):
             for spec in tracker_specs:
