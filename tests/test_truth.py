@@ -88,6 +88,11 @@ def test_pieces_labelled_within_the_visible_box_are_those_of_the_whole_region():
 
     from mtt_sim.sim.truth import pieces_of
 
+    # by hand: a piece starting on row 5 at the right, another on row 6 at the left. Raster order (and OpenCV's 2x2
+    # blocks from row 4) finds the right one first; blocks from row 5 would pair rows 5 and 6 and find the left first
+    mask = np.zeros((20, 20), np.uint8)
+    mask[5:9, 12:16] = mask[6:10, 2:6] = 255
+    np.testing.assert_array_equal(pieces_of(mask, 32, cv2.boundingRect(mask)), [[12, 5, 4, 4], [2, 6, 4, 4]])
     rng, compared = np.random.default_rng(0), 0
     for _ in range(400):
         h, w = (int(v) for v in rng.integers(8, 300, 2))
