@@ -22,7 +22,9 @@ from mtt_sim.core.frame import Truth
 KNOWN = {"model": "synthetic", "pd": 0.85, "pd_spread": 0.8, "miss_corr": 0.6, "visibility_slope": 3.0, "reference_height": 100.0,
          "min_visibility": 0.0, "box_noise": 0.03, "box_size_noise": 0.03, "box_drift": 0.05, "box_size_drift": 0.1,
          "box_drift_corr": 0.8, "box_scale": 1.1, "box_outlier_prob": 0.02, "box_outlier_persist": 0.3, "clutter_rate": 1.0,
-         "site_rate": 0.1, "site_life": 15.0, "site_near": 0.3, "merge_prob": 0.0, "fragment_prob": 0.0}
+         "site_rate": 0.1, "site_life": 15.0, "site_near": 0.3, "merge_prob": 0.0, "fragment_prob": 0.0,
+         "conf_true": 0.9, "conf_visibility": 1.5, "conf_spread": 12.0, "conf_outlier": -1.5, "conf_false": 0.4,
+         "conf_false_spread": 3.0}
 
 
 def people(frames, count=8, spacing=150.0, life=100):
@@ -50,7 +52,9 @@ def test_calibrate_recovers_the_detector_that_made_the_detections(twin):
     tolerance = {"pd": 0.05, "pd_spread": 0.25, "miss_corr": 0.08, "visibility_slope": 0.8, "box_noise": 0.008, "box_size_noise": 0.01,
                  "box_drift": 0.008, "box_size_drift": 0.01, "box_drift_corr": 0.05, "box_scale": 0.02,
                  "box_outlier_prob": 0.015, "box_outlier_persist": 0.1, "clutter_rate": 0.15, "site_rate": 0.04,
-                 "site_life": 4.0}
+                 "site_life": 4.0, "conf_true": 0.02, "conf_visibility": 0.3, "conf_spread": 2.5, "conf_outlier": 0.3,
+                 "conf_false": 0.03, "conf_false_spread": 0.6}
+    # conf_spread: the fit reads the confidences' range off the data (padded by 1 %), which tightens them a little
     off = {k: (KNOWN[k], fitted[k]) for k, tol in tolerance.items() if abs(fitted[k] - KNOWN[k]) > tol}
     assert not off, off
 

@@ -197,3 +197,12 @@ def test_confidences_can_be_raw_scores_and_fall_with_visibility():
     full, half = (1 / (1 + np.exp(-(np.log(4) - 2 * v))) for v in (0.0, 0.5))
     assert abs(conf[1].mean() - (-1 + 3 * full)) < 0.02 and abs(conf[2].mean() - (-1 + 3 * half)) < 0.02
     assert conf[1].min() >= -1 and conf[1].max() <= 2
+
+
+def test_outliers_score_lower_by_conf_outlier_on_the_logit_scale():
+    keys = {"pd": 1.0, "conf_true": 0.8, "conf_visibility": 0.0, "conf_spread": 50.0, "box_outlier_prob": 1.0,
+            "box_outlier_persist": 1.0, "clutter_rate": 0.0}
+    for shift, mean in ((0.0, 0.8), (-1.0, 1 / (1 + np.exp(-(np.log(4) - 1.0))))):  # logit(0.8) = log 4
+        conf = np.array([c for d in frames_of({**keys, "conf_outlier": shift}, 2000)
+                         for c, s in zip(d.rows[:, 4], d.sources) if s == 1])
+        assert len(conf) == 2000 and abs(conf.mean() - mean) < 0.01, (shift, conf.mean(), mean)

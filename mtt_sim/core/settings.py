@@ -110,6 +110,9 @@ class SensorConfig:
                                   "logit", 0.0, 100.0)
     conf_height: float = setting(0.0, "logit of the mean true confidence lost per halving of the box height below "
                               "reference_height", "logit", -10.0, 10.0)
+    conf_outlier: float = setting(0.0, "logit of the mean confidence an outlier (a detection with a poor box) has beside "
+                               "a good detection of the same target (real detectors score poor boxes lower)", "logit",
+                               -20.0, 20.0)
     conf_false: float = setting(0.35, "mean confidence of a false detection", "", 0.01, 0.99)
     conf_spread: float = setting(8.0, "Beta concentration of the true confidences (higher = tighter)", "", 0.5, 1e4)
     conf_false_spread: float = setting(0.0, "Beta concentration of the false confidences (0 = conf_spread)", "", 0.0, 1e4)

@@ -303,7 +303,7 @@ class SyntheticSensor(Sensor):
             means.append(np.full(len(parts), 0.8 * mean[o]))
             rows.append(np.full(len(parts), lead[o]))
         boxes.append(box[outlier])
-        means.append(mean[outlier])
+        means.append(mean[outlier] if cfg.conf_outlier == 0 else expit(logit(mean[outlier]) + cfg.conf_outlier))
         rows.append(lead[outlier])
         kind = np.repeat([0, 1] + [1] * int(split.sum()) + [2], [len(r) for r in rows])
         return np.concatenate(boxes).astype(float), np.concatenate(means), np.concatenate(rows).astype(int), kind

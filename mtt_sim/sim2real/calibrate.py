@@ -15,8 +15,9 @@ The fit, per part of the model (`mtt_sim.sim.sensor`):
   and the share of one-frame runs give fresh clutter, the site birth rate and the site life (matched moments);
   the share of runs that overlap a person (IoU >= 0.1) is site_near;
 - merges and fragments: counted (a false positive covering two overlapping people; several inside a missed one);
-- confidences: offset and scale from their range; the mean of true detections' confidences by non-linear least
-  squares in visibility and height; Beta concentrations by moments.
+- confidences: offset and scale from their range; the good boxes' mean confidence (logistic in visibility and
+  height) and Beta concentration by maximum likelihood, the outliers' lower mean by maximum likelihood, the false
+  positives' Beta by moments.
 `statistics` measures the same things on any detections of a ground truth, so the twin is checked against the data
 with one function.
 """
@@ -29,8 +30,8 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
-from scipy.optimize import brentq, least_squares, minimize
-from scipy.special import expit, logit, logsumexp
+from scipy.optimize import brentq, least_squares, minimize, minimize_scalar
+from scipy.special import betaln, expit, logit, logsumexp
 
 from mtt_sim.boxes import box_iou, match, overlap, overlapping_pairs, union_boxes
 from mtt_sim.core.frame import Truth
@@ -291,24 +292,41 @@ def _fit_false_positives(a: Associated) -> dict:
 
 
 def _fit_confidences(a: Associated, reference: float) -> dict:
-    """Offset and scale from the range; true mean by least squares in visibility and height; Beta concentrations."""
+    """Offset and scale from the range; the good boxes' mean (logistic in visibility and height, as
+    `sensor.true_confidence`) and Beta concentration by maximum likelihood; the outliers' shift of that mean's logit
+    by maximum likelihood given them; the false positives' Beta by moments. Real true confidences are skewed toward
+    the top and poor boxes score lower: matched by moments, the true ones spread low, and a tracker's confidence
+    threshold dropped true detections in the twin where it drops false ones on real video."""
     lo, hi = float(a.det_conf.min()), float(a.det_conf.max())
     pad = 0.01 * max(hi - lo, 1e-3)
     offset, scale = lo - pad, (hi - lo) + 2 * pad
-    true = a.detected
-    y = (a.conf[true] - offset) / scale
-    x = np.c_[a.visibility[true] - 1, np.log2(np.maximum(a.height[true], 1e-3) / reference)]
-    start = np.array([logit(np.clip(y.mean(), 0.02, 0.98)), 0.0, 0.0])
-    b = least_squares(lambda b: expit(b[0] + x @ b[1:]) - y, start).x
-    mean = expit(b[0] + x @ b[1:])
-    spread = np.sum(mean * (1 - mean)) / max(np.sum((y - mean) ** 2), 1e-12) - 1
+    y = np.clip((a.conf - offset) / scale, 1e-6, 1 - 1e-6)
+    x = np.c_[a.visibility - 1, np.minimum(np.log2(np.maximum(a.height, 1e-3) / reference), 0.0)]
+    good, poor = a.hit, a.detected & ~a.hit
+    start = least_squares(lambda b: expit(b[0] + x[good] @ b[1:]) - y[good],
+                          np.array([logit(np.clip(y[good].mean(), 0.02, 0.98)), 0.0, 0.0])).x
+    fit = minimize(lambda t: _beta_cost(y[good], t[0] + x[good] @ t[1:3], math.exp(t[3])),
+                   np.r_[start, math.log(4.0)], method="L-BFGS-B",
+                   bounds=[(-20, 20), (0, 100), (-10, 10), (math.log(0.5), math.log(1e4))]).x
+    b, spread = fit[:3], math.exp(fit[3])
+    shift = 0.0
+    if poor.sum() >= 10:
+        shift = minimize_scalar(lambda s: _beta_cost(y[poor], b[0] + x[poor] @ b[1:] + s, spread),
+                                bounds=(-20, 20), method="bounded").x
     f = (a.det_conf[a.det_kind == 2] - offset) / scale
     false_mean = float(f.mean()) if len(f) else 0.35
     false_spread = false_mean * (1 - false_mean) / max(float(f.var()), 1e-12) - 1 if len(f) > 1 else 0.0
-    return {"conf_true": float(np.clip(expit(b[0]), 0.01, 0.99)), "conf_visibility": float(np.clip(b[1], 0, 100)),
-            "conf_height": float(np.clip(b[2], -10, 10)), "conf_spread": float(np.clip(spread, 0.5, 1e4)),
+    return {"conf_true": float(np.clip(expit(b[0]), 0.01, 0.99)), "conf_visibility": float(b[1]),
+            "conf_height": float(b[2]), "conf_spread": spread, "conf_outlier": float(shift),
             "conf_false": float(np.clip(false_mean, 0.01, 0.99)),
             "conf_false_spread": float(np.clip(false_spread, 0.5, 1e4)), "conf_offset": offset, "conf_scale": scale}
+
+
+def _beta_cost(y: np.ndarray, eta: np.ndarray, k: float) -> float:
+    """Mean negative log-likelihood of `y` under Beta draws of mean expit(eta) and concentration k."""
+    m = np.clip(expit(eta), 1e-6, 1 - 1e-6)
+    alpha, beta = m * k, (1 - m) * k
+    return float(-np.mean((alpha - 1) * np.log(y) + (beta - 1) * np.log1p(-y) - betaln(alpha, beta)))
 
 
 # ------------------------------------------------------------------ statistics, on the data and on the twin
@@ -342,11 +360,20 @@ def statistics(a: Associated) -> dict:
                 "false positives beside a person (share)": a.det_near[false].mean() if false.any() else math.nan,
                 "mean IoU of true detections": np.nanmean(a.iou[true]) if true.any() else math.nan,
                 "average precision": average_precision(a.det_conf, a.det_kind == 0, len(a.frame)),
+                "precision, lowest fifth of confidences": _low_precision(a.det_conf, a.det_kind == 0),
                 "confidence, true (mean)": np.nanmean(a.conf[true]) if true.any() else math.nan,
                 "confidence, true (std)": np.nanstd(a.conf[true]) if true.any() else math.nan,
                 "confidence, false (mean)": a.det_conf[false].mean() if false.any() else math.nan,
                 "confidence, false (std)": a.det_conf[false].std() if false.any() else math.nan})
     return {k: float(v) for k, v in out.items()}
+
+
+def _low_precision(conf: np.ndarray, true: np.ndarray, share: float = 0.2) -> float:
+    """The share of true detections among the `share` of the detections with the lowest confidences: what a tracker's
+    confidence threshold drops."""
+    if not len(conf):
+        return math.nan
+    return float(true[conf <= np.quantile(conf, share)].mean())
 
 
 def average_precision(conf: np.ndarray, true: np.ndarray, positives: int) -> float:
