@@ -30,15 +30,15 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
-from scipy.optimize import brentq, least_squares, minimize, minimize_scalar
-from scipy.special import betaln, expit, logit, logsumexp
+from scipy.optimize import brentq, minimize
+from scipy.special import expit, logit, logsumexp
 
 from mtt_sim.boxes import box_iou, match, overlap, overlapping_pairs, union_boxes
 from mtt_sim.core.frame import Truth
 from mtt_sim.real.sequence import Recording, SequenceConfig
 from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.sensor import twin_sensor
-from mtt_sim.sim2real import truth_statistics
+from mtt_sim.sim2real import fit_confidences, truth_statistics
 
 MATCH_IOU = 0.5     # a true detection
 OUTLIER_IOU = 0.3   # a detection of the person with a poor box
@@ -173,7 +173,7 @@ def fit(a: Associated) -> dict:
     out.update(_fit_misses(a))
     out.update(_fit_boxes(a))
     out.update(_fit_false_positives(a))
-    out.update(_fit_confidences(a, out["reference_height"]))
+    out.update(fit_confidences.fit(a, out["reference_height"]))
     out["merge_prob"] = a.merged / a.pairs if a.pairs else 0.0
     out["fragment_prob"] = a.fragmented / len(a.frame)
     return {k: (round(float(v), 4) if isinstance(v, (float, np.floating)) else v) for k, v in out.items()}
@@ -289,44 +289,6 @@ def _fit_false_positives(a: Associated) -> dict:
     lasting = lengths > 1
     return {"clutter_rate": clutter, "site_rate": sites, "site_life": max(life, 1.0),
             "site_near": float(near[lasting].mean() if lasting.any() else near.mean())}
-
-
-def _fit_confidences(a: Associated, reference: float) -> dict:
-    """Offset and scale from the range; the good boxes' mean (logistic in visibility and height, as
-    `sensor.true_confidence`) and Beta concentration by maximum likelihood; the outliers' shift of that mean's logit
-    by maximum likelihood given them; the false positives' Beta by moments. Real true confidences are skewed toward
-    the top and poor boxes score lower: matched by moments, the true ones spread low, and a tracker's confidence
-    threshold dropped true detections in the twin where it drops false ones on real video."""
-    lo, hi = float(a.det_conf.min()), float(a.det_conf.max())
-    pad = 0.01 * max(hi - lo, 1e-3)
-    offset, scale = lo - pad, (hi - lo) + 2 * pad
-    y = np.clip((a.conf - offset) / scale, 1e-6, 1 - 1e-6)
-    x = np.c_[a.visibility - 1, np.minimum(np.log2(np.maximum(a.height, 1e-3) / reference), 0.0)]
-    good, poor = a.hit, a.detected & ~a.hit
-    start = least_squares(lambda b: expit(b[0] + x[good] @ b[1:]) - y[good],
-                          np.array([logit(np.clip(y[good].mean(), 0.02, 0.98)), 0.0, 0.0])).x
-    fit = minimize(lambda t: _beta_cost(y[good], t[0] + x[good] @ t[1:3], math.exp(t[3])),
-                   np.r_[start, math.log(4.0)], method="L-BFGS-B",
-                   bounds=[(-20, 20), (0, 100), (-10, 10), (math.log(0.5), math.log(1e4))]).x
-    b, spread = fit[:3], math.exp(fit[3])
-    shift = 0.0
-    if poor.sum() >= 10:
-        shift = minimize_scalar(lambda s: _beta_cost(y[poor], b[0] + x[poor] @ b[1:] + s, spread),
-                                bounds=(-20, 20), method="bounded").x
-    f = (a.det_conf[a.det_kind == 2] - offset) / scale
-    false_mean = float(f.mean()) if len(f) else 0.35
-    false_spread = false_mean * (1 - false_mean) / max(float(f.var()), 1e-12) - 1 if len(f) > 1 else 0.0
-    return {"conf_true": float(np.clip(expit(b[0]), 0.01, 0.99)), "conf_visibility": float(b[1]),
-            "conf_height": float(b[2]), "conf_spread": spread, "conf_outlier": float(shift),
-            "conf_false": float(np.clip(false_mean, 0.01, 0.99)),
-            "conf_false_spread": float(np.clip(false_spread, 0.5, 1e4)), "conf_offset": offset, "conf_scale": scale}
-
-
-def _beta_cost(y: np.ndarray, eta: np.ndarray, k: float) -> float:
-    """Mean negative log-likelihood of `y` under Beta draws of mean expit(eta) and concentration k."""
-    m = np.clip(expit(eta), 1e-6, 1 - 1e-6)
-    alpha, beta = m * k, (1 - m) * k
-    return float(-np.mean((alpha - 1) * np.log(y) + (beta - 1) * np.log1p(-y) - betaln(alpha, beta)))
 
 
 # ------------------------------------------------------------------ statistics, on the data and on the twin
