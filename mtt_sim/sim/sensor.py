@@ -41,22 +41,24 @@ def detection_probabilities(visibility: np.ndarray, height: np.ndarray, cfg: Sen
     correlation miss_corr has P as its long-run share of detected frames: after a detection P + (1 - P) miss_corr,
     after a miss P (1 - miss_corr).
     """
-    shift = cfg.visibility_slope * (visibility - 1) + cfg.height_slope * log_height(height, cfg) + ease
+    shift = (cfg.visibility_slope * (visibility - 1) + cfg.height_slope * log_height(height, cfg.reference_height)
+             + ease)
     with np.errstate(divide="ignore"):
         p = np.where(visibility > cfg.min_visibility, expit(logit(cfg.pd) + shift), 0.0)
     return p, p + (1 - p) * cfg.miss_corr, p * (1 - cfg.miss_corr)
 
 
-def log_height(height: np.ndarray, cfg: SensorConfig) -> np.ndarray:
-    """min(0, log2(height / reference_height)): the size covariate of detection and confidence (a detector finds small
-    people harder; above some height, size no longer helps)."""
-    return np.minimum(np.log2(np.maximum(height, 1e-3) / cfg.reference_height), 0.0)
+def log_height(height: np.ndarray, reference: float) -> np.ndarray:
+    """min(0, log2(height / reference)): the size covariate of detection and confidence (a detector finds small people
+    harder; above the reference height, size no longer helps)."""
+    return np.minimum(np.log2(np.maximum(height, 1e-3) / reference), 0.0)
 
 
 def true_confidence(visibility: np.ndarray, height: np.ndarray, cfg: SensorConfig) -> np.ndarray:
     """Mean confidence (before conf_offset / conf_scale) of a true detection: logit(conf_true) + conf_visibility
     (visibility - 1) + conf_height log_height, through the logistic."""
-    return expit(logit(cfg.conf_true) + cfg.conf_visibility * (visibility - 1) + cfg.conf_height * log_height(height, cfg))
+    return expit(logit(cfg.conf_true) + cfg.conf_visibility * (visibility - 1)
+                 + cfg.conf_height * log_height(height, cfg.reference_height))
 
 
 def touching(labels: np.ndarray, la: int, lb: int, box: np.ndarray) -> bool:

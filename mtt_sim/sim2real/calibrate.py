@@ -37,7 +37,7 @@ from mtt_sim.boxes import box_iou, match, overlap, overlapping_pairs, union_boxe
 from mtt_sim.core.frame import Truth
 from mtt_sim.real.sequence import Recording, SequenceConfig
 from mtt_sim.sim import scenario as scn
-from mtt_sim.sim.sensor import twin_sensor
+from mtt_sim.sim.sensor import log_height, twin_sensor
 from mtt_sim.sim2real import fit_confidences, truth_statistics
 
 MATCH_IOU = 0.5     # a true detection
@@ -215,7 +215,7 @@ def _fit_misses(a: Associated) -> dict:
     best = None
     start = np.array([logit(np.clip(y.mean(), 0.01, 0.99)), 2.0, 1.0, 0.0])
     for knee in np.unique(np.round(np.quantile(h, np.linspace(0.1, 0.9, 9)))):
-        x = np.c_[np.ones(len(y)), v, np.minimum(np.log2(np.maximum(h, 1e-3) / knee), 0)]
+        x = np.c_[np.ones(len(y)), v, log_height(h, knee)]
         res = minimize(nll_fixed, start, args=(x,), method="L-BFGS-B")
         if best is None or res.fun < best[0]:
             best = (res.fun, res.x, knee, x)

@@ -12,6 +12,8 @@ import numpy as np
 from scipy.optimize import least_squares, minimize, minimize_scalar
 from scipy.special import betaln, expit, logit
 
+from mtt_sim.sim.sensor import log_height
+
 
 def fit(a, reference: float) -> dict:
     """The confidence keys fitted to associated detections `a` (a `calibrate.Associated`; `reference`: the height
@@ -24,13 +26,13 @@ def fit(a, reference: float) -> dict:
     pad = 0.01 * max(hi - lo, 1e-3)
     offset, scale = lo - pad, (hi - lo) + 2 * pad
     y = np.clip((a.conf - offset) / scale, 1e-6, 1 - 1e-6)
-    x = np.c_[a.visibility - 1, np.minimum(np.log2(np.maximum(a.height, 1e-3) / reference), 0.0)]
+    x = np.c_[a.visibility - 1, log_height(a.height, reference)]
     good, poor = a.hit, a.detected & ~a.hit
     start = least_squares(lambda b: expit(b[0] + x[good] @ b[1:]) - y[good],
                           np.array([logit(np.clip(y[good].mean(), 0.02, 0.98)), 0.0, 0.0])).x
     theta = minimize(lambda t: _beta_cost(y[good], t[0] + x[good] @ t[1:3], math.exp(t[3])),
-                   np.r_[start, math.log(4.0)], method="L-BFGS-B",
-                   bounds=[(-20, 20), (0, 100), (-10, 10), (math.log(0.5), math.log(1e4))]).x
+                     np.r_[start, math.log(4.0)], method="L-BFGS-B",
+                     bounds=[(-20, 20), (0, 100), (-10, 10), (math.log(0.5), math.log(1e4))]).x
     b, spread = theta[:3], math.exp(theta[3])
     shift = 0.0
     if poor.sum() >= 10:
