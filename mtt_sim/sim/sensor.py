@@ -305,6 +305,7 @@ class SyntheticSensor(Sensor):
             means.append(np.full(len(parts), 0.8 * mean[o]))
             rows.append(np.full(len(parts), lead[o]))
         boxes.append(box[outlier])
+        # outliers score lower by conf_outlier (logit); at 0 the means are taken as they are, the draws as before to the bit
         means.append(mean[outlier] if cfg.conf_outlier == 0 else expit(logit(mean[outlier]) + cfg.conf_outlier))
         rows.append(lead[outlier])
         kind = np.repeat([0, 1] + [1] * int(split.sum()) + [2], [len(r) for r in rows])
