@@ -208,3 +208,38 @@ def test_people_who_stand_are_fitted_standing(tmp_path):
     assert walk["stop_rate"] / (walk["stop_rate"] + walk["go_rate"]) > 0.6  # six of eight stand, in the long run
     frames = fit_walkers.simulate(WalkConfig(**walk), RATE, people=60, duration=10.0)
     assert motion.people(frames, RATE)["standing"] > 0.5
+
+
+def straight_walkers(speed: float, people: int = 8) -> tuple[np.ndarray, list]:
+    """People walking along x at `speed` heights a second, each in every one of LONG frames: as tracklet rows (frame
+    from 0, id, x, y, w, h) and as frames of (ids, boxes)."""
+    from mtt_sim.sim2real import fit_motion
+
+    step = speed * TALL / RATE
+    rows = np.array([(f, i, 50.0 + step * f, 60.0 + 45 * i, 0.4 * TALL, TALL) for i in range(people)
+                     for f in range(LONG)])
+    return rows, fit_motion.frames_of(rows, LONG)
+
+
+def test_refine_sets_the_desired_speed_at_which_the_scenes_people_walk_as_the_sequence_shows():
+    """A scene whose people walk 0.7 times its desired speed; the sequence's tracklets walk half a height a second:
+    the refinement sets the desired speed 0.5 / 0.7, read off the scene's people, not its tracklets (which here walk
+    at twice the people's speed, as boxes that drift would show people faster than they walk)."""
+    from mtt_sim.sim2real import fit_motion
+
+    seq_rows, _ = straight_walkers(0.5)
+    target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
+    assert target[4] == pytest.approx(0.5)  # the median walking speed
+    runs = []
+
+    def scene(raw, seed):
+        runs.append(raw["walk"]["speed"])
+        rows, _ = straight_walkers(2 * 0.7 * raw["walk"]["speed"])
+        return rows, straight_walkers(0.7 * raw["walk"]["speed"])[1]
+
+    raw = {"walk": {"model": "langevin", "speed": 0.4, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1},
+           "sensor": {"preset": "ideal"}}
+    refined, history = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
+    assert refined["walk"]["speed"] == pytest.approx(0.5 / 0.7, abs=1e-3)
+    assert refined["walk"]["stop_rate"] == 0.1  # nobody stands, in the sequence or the scene
+    assert history[1][2][4] == pytest.approx(0.7 * 0.4) and history[-1][0]["speed"] == refined["walk"]["speed"]

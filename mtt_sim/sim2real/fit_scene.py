@@ -54,15 +54,19 @@ STAT_NAMES = {"people": "people per frame", "births": "births per frame", "heigh
               "far_near": "far/near height ratio", "speed": "median speed (px/frame)"}
 
 
-def link(env, seed: int = 0) -> np.ndarray:
-    """SORT run over an env's own detections: (n, 6) rows frame, id, x, y, w, h of tracklets of MIN_FRAMES or more."""
+def link(env, seed: int = 0, truth: list | None = None) -> np.ndarray:
+    """SORT run over an env's own detections: (n, 6) rows frame, id, x, y, w, h of tracklets of MIN_FRAMES or more.
+    Each frame's scored truth (ids, boxes) is appended to `truth` where it is given (a simulated scene's people)."""
     from mtt_sim import trackers
 
-    rows = []
+    rows, no_tracks = [], np.zeros((0, 4))
     for ep in Episode(env, seed, trackers.make(LINKER)):
         t = ep.tracks
         if t is not None and len(t):
             rows.append(np.column_stack([np.full(len(t), ep.steps), t.ids, t.boxes]))
+        if truth is not None:
+            scored = env.source.scored_truth(no_tracks)
+            truth.append((scored.ids, scored.boxes))
     rows = np.concatenate(rows) if rows else np.zeros((0, 6))
     ids, counts = np.unique(rows[:, 1], return_counts=True)
     return rows[np.isin(rows[:, 1], ids[counts >= MIN_FRAMES])]
@@ -215,9 +219,11 @@ def report(real: dict, scene: dict, name: str) -> str:
     return "\n".join(lines)
 
 
-def _scene_tracklets(raw: dict, seed: int) -> np.ndarray:
-    """The tracklets of one run of the scene `raw`, linked as a sequence's are."""
-    return link(TrackingEnv(scn.from_mapping(raw, "fitted scene"), obs_mode="detections"), seed)
+def _scene_tracklets(raw: dict, seed: int) -> tuple[np.ndarray, list]:
+    """The tracklets of one run of the scene `raw`, linked as a sequence's are, and its people (each frame's scored
+    ids and boxes)."""
+    truth: list = []
+    return link(TrackingEnv(scn.from_mapping(raw, "fitted scene"), obs_mode="detections"), seed, truth), truth
 
 
 def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[dict, dict, dict, str]:
