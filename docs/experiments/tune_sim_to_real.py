@@ -170,6 +170,9 @@ def picks(by: dict, routes: list[str], metric: str) -> list[str]:
         cells = []
         for r in routes:
             got = [by[k] for k in by if k[1] == s and k[2] == r]
+            if len(got) < len(oracle):  # a pick among some of the trackers is none (rows still coming, say)
+                cells.append("-")
+                continue
             pick = max(got, key=lambda g: g["tuned_value"])
             gaps[r].append(100 * (best["real"] - pick["real"]))
             cells.append(f"{pick['tracker']} {100 * pick['real']:.1f}")
