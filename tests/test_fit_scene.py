@@ -230,10 +230,8 @@ def test_refine_sets_the_desired_speed_at_which_the_scenes_people_walk_as_the_se
     seq_rows, _ = straight_walkers(0.5)
     target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
     assert target[4] == pytest.approx(0.5)  # the median walking speed
-    runs = []
 
     def scene(raw, seed):
-        runs.append(raw["walk"]["speed"])
         rows, _ = straight_walkers(2 * 0.7 * raw["walk"]["speed"])
         return rows, straight_walkers(0.7 * raw["walk"]["speed"])[1]
 

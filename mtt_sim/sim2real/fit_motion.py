@@ -58,7 +58,8 @@ MIN_WINDOWS = 100     # two-second stretches of tracklets the walkers' relaxatio
 SIM_PEOPLE, SIM_SECONDS = 60, 15.0  # the walkers simulated for each try of the fit
 REFINE_WINDOWS = 2000  # one-second windows of the scene's tracklets each run of the refinement pools over seeds ...
 MAX_SEEDS = 12        # ... taking at most this many (a short sequence's scene gives few windows a seed)
-LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0), "speed": (0.0, 10.0)}
+LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0),
+          "speed": tuple(scn.setting_of("walk.speed")[1][end] for end in ("lo", "hi"))}
 REACH = {"noise": 10.0, "stop_rate": 10.0, "speed": 3.0}  # the refinement moves each at most this far from the fit
 NOISE_KEYS = ("box_noise", "box_size_noise", "box_drift", "box_size_drift")  # the detector's, scaled to the jitter
 NOISE_REACH = 4.0     # ... at most this far either way
@@ -279,7 +280,7 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     Returns the scene and the runs' keys and measurements (tracklets', then people's)."""
     walk = dict(raw["walk"])
     history: list[tuple[dict, np.ndarray, np.ndarray]] = []
-    if not np.all(np.isfinite(target[:4])):
+    if not _complete(target):
         return raw, history
 
     def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray]:  # pooled over seeds, up to REFINE_WINDOWS windows
@@ -300,14 +301,14 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     raw = _detector_scaled(raw, target[3] / run(raw, walk)[0][3])
     for _ in range(2):  # two steps: the stop rate and the desired speed move each other's statistic
         first, people = run(raw, walk)
-        if not np.all(np.isfinite(first[:4])):
+        if not _complete(first):
             return {**raw, "walk": walk}, history
         factor = {"stop_rate": _odds(target[2]) / _odds(people[2]), "speed": target[4] / people[4]}
         walk = {**walk, **{k: _scaled(max(walk[k], 0.01), f, k) for k, f in factor.items() if np.isfinite(f)}}
     first = run(raw, walk)[0]
     low = {**walk, "noise": round(max(walk["noise"] / 10, LIMITS["noise"][0]), 4)}
     second = run(raw, low)[0]
-    if not np.all(np.isfinite(second[:4])):
+    if not _complete(second):
         return {**raw, "walk": walk}, history
     slope = (first[1] ** 2 - second[1] ** 2) / max(walk["noise"] ** 2 - low["noise"] ** 2, 1e-12)
     floor = second[1] ** 2 - slope * low["noise"] ** 2
@@ -317,6 +318,12 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
         noise = walk["noise"] * target[1] / max(first[1], 1e-6)
     final = {**low, "noise": round(float(np.clip(noise, low["noise"], walk["noise"] * REACH["noise"])), 4)}
     return {**raw, "walk": final}, history
+
+
+def _complete(measured: np.ndarray) -> bool:
+    """Whether `_measured` found the speed, the deviation, the standing share and the jitter (the walking speed it
+    need not: nobody may walk a whole second)."""
+    return bool(np.all(np.isfinite(measured[:4])))
 
 
 def _odds(share: float) -> float:
