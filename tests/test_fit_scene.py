@@ -241,3 +241,31 @@ def test_refine_sets_the_desired_speed_at_which_the_scenes_people_walk_as_the_se
     assert refined["walk"]["speed"] == pytest.approx(0.5 / 0.7, abs=1e-3)
     assert refined["walk"]["stop_rate"] == 0.1  # nobody stands, in the sequence or the scene
     assert history[1][2][4] == pytest.approx(0.7 * 0.4) and history[-1][0]["speed"] == refined["walk"]["speed"]
+    # the sequence's people deviate from constant velocity by nothing, and the scene's whatever their noise: the noise
+    # is deflated to the lowest the refinement tries, a tenth of the fit's
+    assert refined["walk"]["noise"] == pytest.approx(0.01)
+
+
+def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequences(monkeypatch):
+    """A fake scene whose tracklets deviate by sqrt(floor^2 + (k noise)^2) (the detector's deviation and the walkers'
+    adding in squares): the refinement solves for the noise at which they deviate as the sequence's do."""
+    from mtt_sim.sim2real import fit_motion
+
+    floor, k, goal = 0.05, 0.8, 0.13
+    seq_rows, _ = straight_walkers(0.5)
+    target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
+    target[1] = goal
+    deviation, measured = {}, fit_motion._measured
+
+    def scene(raw, seed):
+        deviation["now"] = float(np.hypot(floor, k * raw["walk"]["noise"]))
+        return straight_walkers(0.5)[0], straight_walkers(0.5)[1]
+
+    monkeypatch.setattr(fit_motion, "_measured", lambda values, jitter: np.r_[measured(values, jitter)[:1],
+                                                                                deviation["now"],
+                                                                                measured(values, jitter)[2:]])
+    raw = {"walk": {"model": "langevin", "speed": 0.5, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1, "relax": 0.5},
+           "sensor": {"preset": "ideal"}}
+    refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
+    assert refined["walk"]["noise"] == pytest.approx(np.sqrt(goal ** 2 - floor ** 2) / k, abs=1e-4)
+    assert refined["walk"]["relax"] == 0.5  # the fit's, kept

@@ -298,7 +298,8 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
         history.append((dict(w), *got))
         return got
 
-    raw = _detector_scaled(raw, target[3] / run(raw, walk)[0][3])
+    jitter = run(raw, walk)[0][3]
+    raw = _detector_scaled(raw, target[3] / jitter if jitter > 0 else math.nan)  # boxes that never jitter: kept
     for _ in range(2):  # two steps: the stop rate and the desired speed move each other's statistic
         first, people = run(raw, walk)
         if not _complete(first):
