@@ -285,8 +285,8 @@ def test_refine_crowd_scales_the_births_and_the_count_until_the_scenes_tracklets
         return np.zeros((int(round(shown * raw["env"]["max_steps"])), 6)), []
 
     assert len(scene(raw, 0)[0]) / 50 == pytest.approx(12.0)
-    refined = fit_scene.refine_crowd(raw, 3.0, scene, seeds=(0,))
+    refined = fit_scene.refine_crowd(raw, 3.0, scene)
     assert [d.get("birth_rate") for d in refined["doors"]] == [0.025, 0.025, None]
     assert refined["groups"][0]["count"] == 1
     assert len(scene(refined, 0)[0]) / 50 == pytest.approx(3.0)
-    assert fit_scene.refine_crowd(raw, 0.0, scene, seeds=(0,)) == raw  # nothing to match: left as fitted
+    assert fit_scene.refine_crowd(raw, 0.0, scene) == raw  # nothing to match: left as fitted

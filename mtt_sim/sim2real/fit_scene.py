@@ -53,7 +53,8 @@ AGREE_DEG = 45.0     # headings within this of their mean agree
 MOVING = 0.2         # px/frame: slower tracklets have no heading
 CROWD_STEPS = 2      # steps of the crowd's refinement
 CROWD_REACH = 10.0   # ... scaling the births at most this far
-CROWD_POWER = (0.3, 1.5)  # ... and the power of the crowd's response to the births, read off two steps, within these
+CROWD_FRAMES = 3000  # ... measuring the crowd over seeds that make this many frames
+CROWD_POWER = (0.5, 1.5)  # ... and the power of the crowd's response to the births, read off two steps, within these
 STAT_NAMES = {"people": "people per frame", "births": "births per frame", "height": "median height (px)",
               "far_near": "far/near height ratio", "speed": "median speed (px/frame)"}
 
@@ -230,11 +231,13 @@ def _scene_tracklets(raw: dict, seed: int) -> tuple[np.ndarray, list]:
     return link(TrackingEnv(scn.from_mapping(raw, "fitted scene"), obs_mode="detections"), seed, truth), truth
 
 
-def refine_crowd(raw: dict, people: float, tracklets=None, seeds=(100, 101)) -> dict:
+def refine_crowd(raw: dict, people: float, tracklets=None, first_seed: int = 100) -> dict:
     """The scene `raw` with its births (the entry doors' rates) and its people at reset (the group's count) scaled so
     that its tracklets show as many people a frame as the sequence's (`people`, as `statistics` counts them): like
     against like, the same detector and linker on both sides (`tracklets(raw, seed)` runs the scene once, as
-    `fit_motion.refine`'s does; by default `_scene_tracklets`), over `seeds`. The fit takes every tracklet's start for
+    `fit_motion.refine`'s does; by default `_scene_tracklets`), over seeds from `first_seed` on, as many as
+    CROWD_FRAMES frames take (at least two, at most `fit_motion.MAX_SEEDS`: a short scene's crowd varies from seed
+    to seed by half). The fit takes every tracklet's start for
     a birth, and a person whose tracklet breaks starts several, while the scene's people cross the whole picture from
     door to door: unrefined, the scenes held 1.3 to 3.7 times as many people a frame as the real ones on seven of the
     eight shared sequences, and crowds make a tracker's associations harder. CROWD_STEPS steps: the first scales
@@ -242,6 +245,7 @@ def refine_crowd(raw: dict, people: float, tracklets=None, seeds=(100, 101)) -> 
     grow more slowly than its births, for misses and occlusions grow with it); the scale within CROWD_REACH."""
     tracklets = tracklets or _scene_tracklets
     length = scn.from_mapping(raw, "fitted scene").env.max_steps
+    seeds = range(first_seed, first_seed + int(np.clip(math.ceil(CROWD_FRAMES / length), 2, fit_motion.MAX_SEEDS)))
     fitted, tried = raw, []  # (scale, people shown) of each step
     scale = 1.0
     for _ in range(CROWD_STEPS):
