@@ -20,8 +20,8 @@ to what they show (ground truth is never read, so gt/ may be missing or anything
   tracklets with the camera's common motion taken out, then refined by running the scene with its detector and
   linking its detections as the sequence's were, `fit_scene(refine=True)`), entering and leaving by doors at the
   left and right borders in the band of their feet (births: tracklet starts per frame after the first frame, shared
-  by the entry doors; the group's own birth_rate is 0; both the births and the count at reset then scaled by
-  `refine_crowd`, so that the scene's tracklets show as many people a frame as the sequence's), and its camera is the walking camera model fitted to the
+  by the entry doors; the group's own birth_rate is 0; both the births and the count at reset then scaled by the
+  refinement, so that the scene's tracklets show as many people a frame as the sequence's), and its camera is the walking camera model fitted to the
   common motion where the tracklets show one, else the still camera; the group's cv keys (speed, heading) stay, for
   walk.model = "off";
 - the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences), its box
@@ -51,10 +51,6 @@ LINKER = "sort:min_hits=3,max_age=3"
 MIN_FRAMES = 5       # tracklets shorter than this are dropped (false positives, fragments)
 AGREE_DEG = 45.0     # headings within this of their mean agree
 MOVING = 0.2         # px/frame: slower tracklets have no heading
-CROWD_STEPS = 2      # steps of the crowd's refinement
-CROWD_REACH = 10.0   # ... scaling the births at most this far
-CROWD_FRAMES = 3000  # ... measuring the crowd over seeds that make this many frames
-CROWD_POWER = (0.5, 1.5)  # ... and the power of the crowd's response to the births, read off two steps, within these
 STAT_NAMES = {"people": "people per frame", "births": "births per frame", "height": "median height (px)",
               "far_near": "far/near height ratio", "speed": "median speed (px/frame)"}
 
@@ -231,45 +227,6 @@ def _scene_tracklets(raw: dict, seed: int) -> tuple[np.ndarray, list]:
     return link(TrackingEnv(scn.from_mapping(raw, "fitted scene"), obs_mode="detections"), seed, truth), truth
 
 
-def refine_crowd(raw: dict, people: float, tracklets=None, first_seed: int = 100) -> dict:
-    """The scene `raw` with its births (the entry doors' rates) and its people at reset (the group's count) scaled so
-    that its tracklets show as many people a frame as the sequence's (`people`, as `statistics` counts them): like
-    against like, the same detector and linker on both sides (`tracklets(raw, seed)` runs the scene once, as
-    `fit_motion.refine`'s does; by default `_scene_tracklets`), over seeds from `first_seed` on, as many as
-    CROWD_FRAMES frames take (at least two, at most `fit_motion.MAX_SEEDS`: a short scene's crowd varies from seed
-    to seed by half). The fit takes every tracklet's start for
-    a birth, and a person whose tracklet breaks starts several, while the scene's people cross the whole picture from
-    door to door: unrefined, the scenes held 1.3 to 3.7 times as many people a frame as the real ones on seven of the
-    eight shared sequences, and crowds make a tracker's associations harder. CROWD_STEPS steps: the first scales
-    the births by the ratio, the next by the ratio to the power that the last two steps show (a crowd's tracklets
-    grow more slowly than its births, for misses and occlusions grow with it); the scale within CROWD_REACH."""
-    tracklets = tracklets or _scene_tracklets
-    length = scn.from_mapping(raw, "fitted scene").env.max_steps
-    seeds = range(first_seed, first_seed + int(np.clip(math.ceil(CROWD_FRAMES / length), 2, fit_motion.MAX_SEEDS)))
-    fitted, tried = raw, []  # (scale, people shown) of each step
-    scale = 1.0
-    for _ in range(CROWD_STEPS):
-        shown = np.mean([len(tracklets(raw, seed)[0]) for seed in seeds]) / length
-        if shown <= 0 or people <= 0:
-            return raw
-        tried.append((scale, shown))
-        power = 1.0  # the first step proportional; then the crowd's response to the births, read off the last two
-        if len(tried) > 1 and tried[-1][0] != tried[-2][0] and tried[-1][1] != tried[-2][1]:
-            power = float(np.clip(math.log(tried[-1][1] / tried[-2][1]) / math.log(tried[-1][0] / tried[-2][0]),
-                                  *CROWD_POWER))
-        scale = float(np.clip(scale * (people / shown) ** (1 / power), 1 / CROWD_REACH, CROWD_REACH))
-        raw = _crowd_scaled(fitted, scale)
-    return raw
-
-
-def _crowd_scaled(raw: dict, factor: float) -> dict:
-    """The scene with its entry doors' birth rates and its groups' counts times `factor`."""
-    doors = [{**d, "birth_rate": round(d["birth_rate"] * factor, 4)} if d.get("role") == "entry" else d
-             for d in raw.get("doors", [])]
-    groups = [{**g, "count": int(round(g["count"] * factor))} for g in raw.get("groups", [])]
-    return {**raw, "doors": doors, "groups": groups}
-
-
 def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[dict, dict, dict, str]:
     """Fit a scene to a sequence folder's detections, with the detector `sensor` (a sensor file or a mapping of sensor
     keys): (the scene as a mapping with the sensor merged in, the sequence's statistics, the scene's statistics over
@@ -282,8 +239,7 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
     scn.from_mapping(raw, f"scene fitted to {folder}")
     if refine:
         raw = fit_motion.refine(raw, fit_motion.tracklet_motion(rows, info.length, info.frame_rate), _scene_tracklets,
-                                info.length, info.frame_rate)[0]
-        raw = refine_crowd(raw, statistics(rows, info.length, info.height)["people"])  # the walkers' speed moves it
+                                info.length, info.frame_rate, crowd=statistics(rows, info.length, info.height)["people"])[0]
     real = statistics(rows, info.length, info.height)
     scene = scene_statistics(raw, seeds) if seeds else {}
     header = [f"mtt-sim fit-scene: a scene fitted to the detections of {Path(folder).name} alone",
