@@ -269,32 +269,3 @@ def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequen
     refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
     assert refined["walk"]["noise"] == pytest.approx(np.sqrt(goal ** 2 - floor ** 2) / k, abs=1e-4)
     assert refined["walk"]["relax"] == 0.5  # the fit's, kept
-
-
-def test_refine_scales_the_births_and_the_count_until_the_scenes_tracklets_show_the_sequences_crowd():
-    """A fake scene whose tracklets show 40 walkers a frame per birth a frame and one per person at reset: the
-    sequence's tracklets show 3 a frame, the fit's scene 12, so the births and the count are quartered (and stay so,
-    the crowd then matching), the exits untouched."""
-    from mtt_sim.sim2real import fit_motion
-
-    seq_rows, _ = straight_walkers(0.5, people=3)
-    target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
-    raw = {"walk": {"model": "langevin", "speed": 0.5, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1},
-           "sensor": {"preset": "ideal"}, "groups": [{"name": "people", "count": 4}],
-           "doors": [{"rect": [0, 0, 10, 10], "role": "entry", "birth_rate": 0.1},
-                     {"rect": [0, 20, 10, 10], "role": "entry", "birth_rate": 0.1},
-                     {"rect": [-20, 0, 10, 10], "role": "exit"}]}
-    crowds = []
-
-    def scene(raw, seed):
-        births = sum(d.get("birth_rate", 0.0) for d in raw["doors"] if d["role"] == "entry")
-        crowds.append(int(round(40 * births + raw["groups"][0]["count"])))
-        return straight_walkers(0.5, people=crowds[-1])[0], straight_walkers(0.5, people=crowds[-1])[1]
-
-    refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,), crowd=3.0)
-    switch = crowds.index(3)  # the first run's seeds at the fit's crowd, every run after at the sequence's
-    assert set(crowds[:switch]) == {12} and set(crowds[switch:]) == {3}
-    assert [d.get("birth_rate") for d in refined["doors"]] == [0.025, 0.025, None]
-    assert refined["groups"][0]["count"] == 1
-    same, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
-    assert same["doors"] == raw["doors"] and same["groups"] == raw["groups"]  # no crowd given: left as fitted

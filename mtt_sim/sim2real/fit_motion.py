@@ -61,7 +61,6 @@ MAX_SEEDS = 12        # ... taking at most this many (a short sequence's scene g
 LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0),
           "speed": tuple(scn.setting_of("walk.speed")[1][end] for end in ("lo", "hi"))}
 REACH = {"noise": 10.0, "stop_rate": 10.0, "speed": 3.0}  # the refinement moves each at most this far from the fit
-CROWD_REACH = 10.0    # ... and the crowd's births and count at most this many times
 NOISE_KEYS = ("box_noise", "box_size_noise", "box_drift", "box_size_drift")  # the detector's, scaled to the jitter
 NOISE_REACH = 4.0     # ... at most this far either way
 SIDEWAYS = math.cos(math.radians(45))  # a heading whose cosine is beyond this walks across (left or right)
@@ -252,20 +251,11 @@ def _measured(values: dict, jitter: np.ndarray) -> np.ndarray:
 
 
 def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: float,
-           seeds=(100, 101), crowd: float | None = None) -> tuple[dict, list]:
+           seeds=(100, 101)) -> tuple[dict, list]:
     """The scene `raw` (with its detector) with its detector's box noise and its walkers' noise, stop rate and desired
-    speed set so that the scene shows the sequence's tracklets' motion (`target`, from `tracklet_motion`), and, given
-    `crowd` (the sequence's tracklets' boxes a frame), its births and its people at reset so that it shows that crowd.
+    speed set so that the scene shows the sequence's tracklets' motion (`target`, from `tracklet_motion`).
     `tracklets(raw, seed)` runs the scene once: its detections linked as the sequence's were, and its people (each
     frame's scored ids and boxes); each run pools `seeds` and more, up to MAX_SEEDS, until REFINE_WINDOWS windows.
-
-    The crowd: the fit takes every tracklet's start for a birth, and a person whose tracklet breaks starts several,
-    while the scene's people cross the whole picture from door to door; fitted so, the scenes held 0.92-3.66 times
-    the real people a frame on the eight shared sequences, and a crowd makes a tracker's associations harder. So the
-    entry doors' births and the groups' counts are scaled by the sequence's tracklets' boxes a frame over the scene's
-    after each of the first three runs (a crowd's tracklets grow more slowly than its births, for misses and
-    occlusions grow with it: the steps close in from one side), so that the walkers' noise is set in the final crowd
-    (the people's avoidance of each other deviates them too).
 
     Two kinds of statistic, matched two ways. How far people walk in a second and how often they stand, the
     sequence's tracklets show as its people do (on the eight shared sequences, the walking windows' median speed
@@ -293,26 +283,19 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     if not _complete(target):
         return raw, history
 
-    fitted, scale = raw, 1.0  # the crowd as fitted, and the scale of its births and count
-
     def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray]:  # pooled over seeds, up to REFINE_WINDOWS windows
-        nonlocal raw, scale
-        values, jitter, people, boxes = [], [], [], 0
+        values, jitter, people = [], [], []
         for seed in range(seeds[0], seeds[0] + MAX_SEEDS):
             rows, truth = tracklets({**scene, "walk": w}, seed)
             frames = frames_of(rows, length)
             values.append(window_values(frames, frame_rate))
             jitter.append(jitters(frames))
             people.append(window_values(truth, frame_rate))
-            boxes += len(rows)
             if seed - seeds[0] + 1 >= len(seeds) and sum(len(v["speed"]) for v in values) >= REFINE_WINDOWS:
                 break
         pooled = lambda parts: {k: np.concatenate([v[k] for v in parts]) for k in ("speed", "deviation")}  # noqa: E731
         got = (_measured(pooled(values), np.concatenate(jitter)), _measured(pooled(people), np.zeros(0)))
         history.append((dict(w), *got))
-        if crowd and boxes and len(history) <= 3:  # the crowd, scaled after each of the first three runs
-            scale = float(np.clip(scale * crowd * length * len(values) / boxes, 1 / CROWD_REACH, CROWD_REACH))
-            raw = {**raw, **crowd_scaled(fitted, scale)}
         return got
 
     jitter = run(raw, walk)[0][3]
@@ -336,13 +319,6 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
         noise = walk["noise"] * target[1] / max(first[1], 1e-6)
     final = {**low, "noise": round(float(np.clip(noise, low["noise"], walk["noise"] * REACH["noise"])), 4)}
     return {**raw, "walk": final}, history
-
-
-def crowd_scaled(raw: dict, factor: float) -> dict:
-    """The doors and groups of scene `raw` with the entry doors' birth rates and the groups' counts times `factor`."""
-    doors = [{**d, "birth_rate": round(d["birth_rate"] * factor, 4)} if d.get("role") == "entry" else d
-             for d in raw.get("doors", [])]
-    return {"doors": doors, "groups": [{**g, "count": int(round(g["count"] * factor))} for g in raw.get("groups", [])]}
 
 
 def _complete(measured: np.ndarray) -> bool:

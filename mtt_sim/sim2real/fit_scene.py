@@ -20,8 +20,7 @@ to what they show (ground truth is never read, so gt/ may be missing or anything
   tracklets with the camera's common motion taken out, then refined by running the scene with its detector and
   linking its detections as the sequence's were, `fit_scene(refine=True)`), entering and leaving by doors at the
   left and right borders in the band of their feet (births: tracklet starts per frame after the first frame, shared
-  by the entry doors; the group's own birth_rate is 0; both the births and the count at reset then scaled by the
-  refinement, so that the scene's tracklets show as many people a frame as the sequence's), and its camera is the walking camera model fitted to the
+  by the entry doors; the group's own birth_rate is 0), and its camera is the walking camera model fitted to the
   common motion where the tracklets show one, else the still camera; the group's cv keys (speed, heading) stay, for
   walk.model = "off";
 - the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences), its box
@@ -239,7 +238,7 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
     scn.from_mapping(raw, f"scene fitted to {folder}")
     if refine:
         raw = fit_motion.refine(raw, fit_motion.tracklet_motion(rows, info.length, info.frame_rate), _scene_tracklets,
-                                info.length, info.frame_rate, crowd=statistics(rows, info.length, info.height)["people"])[0]
+                                info.length, info.frame_rate)[0]
     real = statistics(rows, info.length, info.height)
     scene = scene_statistics(raw, seeds) if seeds else {}
     header = [f"mtt-sim fit-scene: a scene fitted to the detections of {Path(folder).name} alone",
