@@ -259,11 +259,14 @@ def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequen
 
     def scene(raw, seed):
         deviation["now"] = float(np.hypot(floor, k * raw["walk"]["noise"]))
-        return straight_walkers(0.5)[0], straight_walkers(0.5)[1]
+        return straight_walkers(0.5)
 
-    monkeypatch.setattr(fit_motion, "_measured", lambda values, jitter: np.r_[measured(values, jitter)[:1],
-                                                                                deviation["now"],
-                                                                                measured(values, jitter)[2:]])
+    def with_deviation(values, jitter):  # the straight walkers' statistics, their deviation the fake scene's
+        out = measured(values, jitter)
+        out[1] = deviation["now"]
+        return out
+
+    monkeypatch.setattr(fit_motion, "_measured", with_deviation)
     raw = {"walk": {"model": "langevin", "speed": 0.5, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1, "relax": 0.5},
            "sensor": {"preset": "ideal"}}
     refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
