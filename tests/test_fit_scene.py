@@ -272,3 +272,27 @@ def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequen
     refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
     assert refined["walk"]["noise"] == pytest.approx(np.sqrt(goal ** 2 - floor ** 2) / k, abs=1e-4)
     assert refined["walk"]["relax"] == 0.5  # the fit's, kept
+
+
+def test_refine_keeps_the_fits_noise_where_the_tracklets_are_too_few_to_read_a_deviation():
+    """One person for eight seconds gives 60 one-second windows, fewer than MIN_WINDOWS: the fit kept the shipped
+    relaxation and noise (fit_walkers), and the refinement does not move them off it by the few windows' deviation
+    (the stop rate and the speed it still sets)."""
+    from mtt_sim.sim2real import fit_motion
+
+    seq_rows, _ = straight_walkers(0.5, people=1)
+    target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
+    assert target[5] == 60 < fit_motion.MIN_WINDOWS
+
+    def scene(raw, seed):
+        return straight_walkers(0.5)
+
+    raw = {"walk": {"model": "langevin", "speed": 0.4, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1, "relax": 0.5},
+           "sensor": {"preset": "ideal"}}
+    refined, history = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
+    assert (refined["walk"]["noise"], refined["walk"]["relax"]) == (0.1, 0.5)
+    assert refined["walk"]["speed"] == pytest.approx(0.4)  # its people walk the sequence's 0.5 already
+    assert len(history) == 3  # the jitter's run and the two steps of the stop rate and the speed; no noise runs
+    # with eight people (560 windows) the same scene's noise is deflated, as in the test above
+    many = fit_motion.tracklet_motion(straight_walkers(0.5)[0], LONG, RATE)
+    assert fit_motion.refine(raw, many, scene, LONG, RATE, seeds=(0,))[0]["walk"]["noise"] == pytest.approx(0.01)

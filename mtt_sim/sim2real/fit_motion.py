@@ -226,8 +226,8 @@ def fit(rows: np.ndarray, info) -> dict:
 
 def tracklet_motion(rows: np.ndarray, length: int, frame_rate: float) -> np.ndarray:
     """The median speed, the median one-second deviation (heights), the standing share (as `motion.people` measures
-    them), the median jitter (`jitters`) and the median walking speed (of the windows at STANDING or faster) of
-    tracklet rows (nan where there is none)."""
+    them), the median jitter (`jitters`), the median walking speed (of the windows at STANDING or faster) and the
+    number of windows of tracklet rows (nan where there is none)."""
     frames = frames_of(rows, length)
     return _measured(window_values(frames, frame_rate), jitters(frames))
 
@@ -242,12 +242,12 @@ def jitters(frames) -> np.ndarray:
 
 def _measured(values: dict, jitter: np.ndarray) -> np.ndarray:
     """The median speed and deviation and the standing share of `motion.window_values`' values, the median
-    `jitter` and the median walking speed."""
+    `jitter`, the median walking speed and the number of windows."""
     med = lambda v: float(np.median(v)) if len(v) else float("nan")  # noqa: E731
     speed = values["speed"]
     return np.array([med(speed), med(values["deviation"]),
                      float(np.mean(speed < STANDING)) if len(speed) else float("nan"), med(jitter),
-                     med(speed[speed >= STANDING])])
+                     med(speed[speed >= STANDING]), len(values["deviation"])])
 
 
 def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: float,
@@ -276,7 +276,8 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
        own deviation adds to the floor in squares; the noise is the one that brings the floor up to the sequence's.
        Where the floor is already above the sequence's (the people are steadier than the boxes show, by how much the
        data cannot say) or the runs show no response, the fourth run's noise is scaled by the sequence's deviation
-       over the scene's.
+       over the scene's. Where the sequence's tracklets give fewer than MIN_WINDOWS windows, too few to read their
+       deviation (fit_walkers then kept the shipped relaxation and noise), the noise is kept and runs 4 and 5 skipped.
     Returns the scene and the runs' keys and measurements (tracklets', then people's)."""
     walk = dict(raw["walk"])
     history: list[tuple[dict, np.ndarray, np.ndarray]] = []
@@ -306,6 +307,8 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
             return {**raw, "walk": walk}, history
         factor = {"stop_rate": _odds(target[2]) / _odds(people[2]), "speed": target[4] / people[4]}
         walk = {**walk, **{k: _scaled(max(walk[k], 0.01), f, k) for k, f in factor.items() if np.isfinite(f)}}
+    if target[5] < MIN_WINDOWS:
+        return {**raw, "walk": walk}, history
     first = run(raw, walk)[0]
     low = {**walk, "noise": round(max(walk["noise"] / 10, LIMITS["noise"][0]), 4)}
     second = run(raw, low)[0]
