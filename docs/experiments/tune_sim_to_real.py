@@ -1,6 +1,7 @@
 """Sim-to-real tuning, measured: for each MOTChallenge sequence and tracker, tune on (a) the sequence itself (the
 oracle), (b) its twin (its ground-truth people through a detector fitted on the other sequences), (c) its label-free
-scene (`mtt-sim fit-scene` on its detections, the same detector) and (d) the generic `mot17_like`; score every
+scene (`mtt-sim fit-scene` on its detections, the same detector) and (d) the generic `mot17_like`, at its own 25
+frames a second, or with `--routes generic_clock` at the sequence's (its seqinfo.ini, no label); score every
 result and the defaults on the real sequence. Rows go to OUT.jsonl as they come (a rerun skips the rows there, so
 several processes can share one file, each with its own --trackers); then a Markdown table of the real gains, the
 share of the oracle's gain each route recovers, and which tracker each route would pick.
@@ -26,7 +27,7 @@ from mtt_sim.lab.tune import tune
 from mtt_sim.sim2real.calibrate import calibrate, to_toml
 from mtt_sim.sim2real.fit_scene import fit_scene
 
-ROUTES = ("oracle", "twin", "scene", "generic")
+ROUTES = ("oracle", "twin", "scene", "generic", "generic_clock")
 GENERIC = "mot17_like"
 
 
@@ -35,7 +36,7 @@ def main() -> None:
     p.add_argument("data", help="a folder of MOTChallenge sequence folders")
     p.add_argument("out", help="the rows, one JSON object a line")
     p.add_argument("--trackers", default="sort,bytetrack")
-    p.add_argument("--routes", default=",".join(ROUTES))
+    p.add_argument("--routes", default=",".join(ROUTES[:4]), help=f"of {', '.join(ROUTES)}")
     p.add_argument("--sequences", default="", help="only these sequences (comma-separated names; default all)")
     p.add_argument("--metric", default="HOTA")
     p.add_argument("--trials", type=int, default=30)
@@ -72,15 +73,18 @@ def measure(args, out: Path) -> None:
             scene.write_text(fit_scene(folder, sensor, seeds=())[3])
         twin = {"sensor.model": "synthetic",
                 **{f"sensor.{k}": v for k, v in tomllib.loads(sensor.read_text())["sensor"].items()}}
-        seeds = _seeds(args, TrackingEnv(str(folder)).source.length)
+        recording = TrackingEnv(str(folder)).source
+        seeds = _seeds(args, recording.length)
         for spec in args.trackers.split(","):
             defaults = None
             for route in args.routes.split(","):
                 if (folder.name, spec, route) in done:
                     continue
-                if route == "generic" and spec not in generic:
-                    generic[spec] = tune(spec, [GENERIC], args.metric, args.trials,
-                                         _seeds(args, TrackingEnv(GENERIC).source.config.env.max_steps))[0]
+                clock = {"world.frame_rate": recording.info.frame_rate} if route == "generic_clock" else {}
+                if route.startswith("generic") and (spec, *clock.values()) not in generic:
+                    generic[spec, *clock.values()] = tune(
+                        spec, [GENERIC], args.metric, args.trials,
+                        _seeds(args, TrackingEnv(GENERIC).source.config.env.max_steps), clock)[0]
                 if route == "oracle":
                     result = tune(spec, [str(folder)], args.metric, args.trials)[0]
                 elif route == "twin":
@@ -88,7 +92,7 @@ def measure(args, out: Path) -> None:
                 elif route == "scene":
                     result = tune(spec, [str(scene)], args.metric, args.trials, seeds)[0]
                 else:
-                    result = generic[spec]
+                    result = generic[spec, *clock.values()]
                 defaults = defaults if defaults is not None else _real(folder, spec, args.metric)
                 row = {"sequence": folder.name, "tracker": spec, "route": route, "defaults": defaults,
                        "tuned_value": result.value, "real": _real(folder, result.spec, args.metric),
