@@ -39,9 +39,10 @@ class Record:
         return (self.share is None or self.share >= 0.5) and self.losing == 0
 
 
-# Measured by docs/experiments/tune_sim_to_real.py --record (docs/tuning.md, "The four routes on the walking world"):
-# sort, bytetrack, ocsort and gmphd, 20 trials a study, on the eight shared MOT15 sequences, the twin and the scene
-# with the detector `calibrate` fits (confidences by maximum likelihood, outliers scored lower).
+# Measured by docs/experiments/tune_sim_to_real.py --record (docs/tuning.md, "The four routes on the walking world"
+# and after): sort, bytetrack, ocsort and gmphd, 20 trials a study, on the eight shared MOT15 sequences, the twin and
+# the scene with the detector `calibrate` fits (confidences by maximum likelihood, outliers scored lower), the scenes
+# as `fit-scene` fits them now.
 RECORD: dict[tuple[str, str], Record] = {
     ("generic", "any"): Record(sequences=8, pairs=32, gaining=28, share=0.03, losing=14),
     ("scene", "still"): Record(sequences=6, pairs=24, gaining=20, share=0.5, losing=5),
