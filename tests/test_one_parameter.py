@@ -29,7 +29,7 @@ def test_each_parameter_alone_is_the_defaults_with_that_one_changed(tmp_path):
         "max_age=5": 0}
 
 
-def test_a_route_without_rows_is_one_clear_line(tmp_path, monkeypatch, capsys):
+def test_a_route_without_rows_is_one_clear_line(tmp_path, monkeypatch):
     rows = tmp_path / "rows.jsonl"
     rows.write_text(json.dumps({"sequence": "seq", "tracker": "sort", "route": "twin", "defaults": 0.5,
                                 "real": 0.5, "spec": "sort:max_age=2"}) + "\n")

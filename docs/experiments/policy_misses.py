@@ -20,9 +20,8 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
-from mtt_sim.boxes import box_iou
+from mtt_sim.boxes import EPS, box_iou, match
 from mtt_sim.real.sequence import Recording
 from mtt_sim.trackers.learned import SHIPPED_POLICY, load_policy
 from mtt_sim.trackers.parts.management import FEATURES, Candidates, decisions
@@ -31,13 +30,11 @@ BORDER = FEATURES.index("border")
 
 
 def people_of(boxes: np.ndarray, truth) -> np.ndarray:
-    """Each box's person (ground-truth id) at IoU >= 0.5 by an optimal one-to-one match, -1 for none."""
+    """Each box's person (ground-truth id) by TrackEval's one-to-one match at IoU >= 0.5, -1 for none."""
     who = np.full(len(boxes), -1)
     if len(boxes) and len(truth):
-        iou = box_iou(boxes, truth.boxes)
-        rows, cols = linear_sum_assignment(-iou)
-        ok = iou[rows, cols] >= 0.5
-        who[rows[ok]] = truth.ids[cols[ok]]
+        rows, cols = match(box_iou(boxes, truth.boxes), 0.5 - EPS)
+        who[rows] = truth.ids[cols]
     return who
 
 
@@ -49,7 +46,7 @@ def misses(folder: str, weights: np.ndarray) -> dict[str, float]:
     first = gone = gone_at_border = 0
     late = np.zeros(3, int)  # matches after two or more misses: own person, another, nobody
     for k in range(len(rec)):
-        dets = np.asarray(rec.detections(k), float)[:, :5]
+        dets = rec.detections(k)
         tracks = candidates.tracks
         missed_before = dict(zip(tracks.ids.tolist(), tracks.misses.tolist()))
         features = candidates.propose(dets)

@@ -21,9 +21,9 @@ from mtt_sim.lab.plots import learning_curve
 from mtt_sim.learn.policy_search import learn_policy, replays
 
 PRESETS = ("frcnn", "dpm", "sdp")
-# A sparse street: about a third of mot17_like's people (5-7 in view, as MOT15's cameras see), so that the detector's
-# false positives are as large a share of the boxes as on real sparse cameras (precision at IoU 0.5 about 0.78, real
-# MOT15 0.70-0.94), where mot17_like's crowd of 21 dilutes them (0.82-0.88).
+# A sparse street: about a third of mot17_like's people (6-8 detections a frame, as MOT15's cameras see 3-8), so that
+# the detector's false positives are as large a share of the boxes as on real sparse cameras (precision at IoU 0.5
+# 0.77-0.79; real MOT15 0.49-0.94), where mot17_like's crowd of 21 dilutes them (0.82-0.88).
 SPARSE = {"groups.0.count": 5, "groups.0.birth_rate": 0.005, "groups.1.count": 2, "groups.1.birth_rate": 0.002,
           "doors.0.birth_rate": 0.002, "doors.1.birth_rate": 0.002}
 SPARSE_MOVING = {**SPARSE, "groups.0.count": 11, "groups.0.birth_rate": 0.004, "groups.1.count": 5,

@@ -80,11 +80,11 @@ def measure(args, out: Path) -> None:
             for route in args.routes.split(","):
                 if (folder.name, spec, route) in done:
                     continue
-                clock = {"world.frame_rate": recording.info.frame_rate} if route == "generic_clock" else {}
-                if route.startswith("generic") and (spec, *clock.values()) not in generic:
-                    generic[spec, *clock.values()] = tune(
-                        spec, [GENERIC], args.metric, args.trials,
-                        _seeds(args, TrackingEnv(GENERIC).source.config.env.max_steps), clock)[0]
+                rate = recording.info.frame_rate if route == "generic_clock" else None  # None: the scene's own
+                if route.startswith("generic") and (spec, rate) not in generic:
+                    generic[spec, rate] = tune(spec, [GENERIC], args.metric, args.trials,
+                                               _seeds(args, TrackingEnv(GENERIC).source.config.env.max_steps),
+                                               {"world.frame_rate": rate} if rate else None)[0]
                 if route == "oracle":
                     result = tune(spec, [str(folder)], args.metric, args.trials)[0]
                 elif route == "twin":
@@ -92,7 +92,7 @@ def measure(args, out: Path) -> None:
                 elif route == "scene":
                     result = tune(spec, [str(scene)], args.metric, args.trials, seeds)[0]
                 else:
-                    result = generic[spec, *clock.values()]
+                    result = generic[spec, rate]
                 defaults = defaults if defaults is not None else _real(folder, spec, args.metric)
                 row = {"sequence": folder.name, "tracker": spec, "route": route, "defaults": defaults,
                        "tuned_value": result.value, "real": _real(folder, result.spec, args.metric),
