@@ -80,10 +80,15 @@ def test_the_routes_record_on_real_cameras_of_the_kind_is_told(monkeypatch):
     monkeypatch.setattr(routes, "RECORD", {})
     assert advise.warnings([a, c], "walking") == [routes.caution("scene", "walking")]
     assert "not been measured" in advise.warnings([a, c], "walking")[0]
-    monkeypatch.setattr(routes, "RECORD", {("scene", "still"): routes.Record(6, 12, 8, 0.4, 1)})
+    monkeypatch.setattr(routes, "RECORD", {("scene", "still", routes.ANY): routes.Record(6, 12, 8, 0.4, 1)})
     assert "kept a median 0.40" in advise.warnings([a, c], "still")[0]
-    monkeypatch.setattr(routes, "RECORD", {("scene", "still"): routes.Record(6, 12, 8, 0.8, 0)})
+    monkeypatch.setattr(routes, "RECORD", {("scene", "still", routes.ANY): routes.Record(6, 12, 8, 0.8, 0)})
     assert advise.warnings([a, c], "still") == []  # a route that held on real cameras of the kind is not doubted
+    # the first choice's own record, where there is one: held for iou, not for sort
+    monkeypatch.setattr(routes, "RECORD", {("scene", "still", "sort"): routes.Record(6, 6, 6, 0.3, 2),
+                                           ("scene", "still", "iou"): routes.Record(6, 6, 6, 0.8, 0)})
+    assert advise.warnings([a, c], "still")[0].startswith("on the shared still cameras (6 MOT15 sequences), sort specs")
+    assert advise.warnings([c], "still") == []
 
 
 @pytest.mark.parametrize("extra, message", [

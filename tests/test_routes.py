@@ -31,10 +31,10 @@ def test_each_source_takes_its_route(sources):
 def test_a_route_is_doubted_unless_its_record_held(monkeypatch):
     monkeypatch.setattr(routes, "RECORD", {})
     assert "has not been measured" in routes.caution("twin", routes.ANY)
-    monkeypatch.setattr(routes, "RECORD", {("twin", routes.ANY): routes.Record(8, 16, 10, 0.7, 0),
-                                           ("generic", routes.ANY): routes.Record(8, 16, 10, 0.7, 3),
-                                           ("scene", "walking"): routes.Record(2, 4, 3, -0.3, 0),
-                                           ("scene", "still"): routes.Record(6, 12, 0, None, 1)})
+    monkeypatch.setattr(routes, "RECORD", {("twin", routes.ANY, routes.ANY): routes.Record(8, 16, 10, 0.7, 0),
+                                           ("generic", routes.ANY, routes.ANY): routes.Record(8, 16, 10, 0.7, 3),
+                                           ("scene", "walking", routes.ANY): routes.Record(2, 4, 3, -0.3, 0),
+                                           ("scene", "still", routes.ANY): routes.Record(6, 12, 0, None, 1)})
     assert routes.caution("twin", routes.ANY) is None
     assert routes.caution("generic", routes.ANY).startswith("on the shared sequences (8 MOT15 sequences), specs tuned "
                                                             "on a generic scenario kept a median 0.70")
@@ -55,15 +55,36 @@ def test_the_record_is_computed_from_the_rows():
     got = routes.records(rows, {"A": "still", "B": "still", "C": "walking"})
     # A gains 10 points on its labels, the scene keeps 5 of them; B's labels gain half a point (no share), and its
     # scene loses 2 points; C's scene keeps 2 of 20; the twin keeps 8 of 10 on A and loses 10 on C (-0.5 of 20)
-    assert got[("scene", "still")] == routes.Record(sequences=2, pairs=2, gaining=1, share=0.5, losing=1)
-    assert got[("scene", "walking")] == routes.Record(sequences=1, pairs=1, gaining=1, share=0.1, losing=0)
-    assert got[("twin", routes.ANY)] == routes.Record(sequences=3, pairs=3, gaining=2, share=0.15, losing=1)
+    assert got[("scene", "still", "sort")] == routes.Record(sequences=2, pairs=2, gaining=1, share=0.5, losing=1)
+    assert got[("scene", "walking", "sort")] == routes.Record(sequences=1, pairs=1, gaining=1, share=0.1, losing=0)
+    assert got[("twin", routes.ANY, "sort")] == routes.Record(sequences=3, pairs=3, gaining=2, share=0.15, losing=1)
+    # a second tracker (a spec, recorded by its registered name) pooled with the first; routes without a name are left out
+    rows += [row("A", "lmb:reid=false", "oracle", 0.50), row("A", "lmb:reid=false", "twin", 0.30),
+             row("A", "lmb:reid=false", "generic_clock", 0.30)]
+    got = routes.records(rows, {"A": "still", "B": "still", "C": "walking"})
+    assert got[("twin", routes.ANY, "lmb")] == routes.Record(sequences=1, pairs=1, gaining=1, share=-1.0, losing=1)
+    assert got[("twin", routes.ANY, routes.ANY)] == routes.Record(sequences=3, pairs=4, gaining=3, share=-0.5,
+                                                                  losing=2)
+    assert {route for route, _, _ in got} == {"scene", "twin"}
+
+
+def test_a_trackers_own_record_is_told_before_the_pooled_one(monkeypatch):
+    monkeypatch.setattr(routes, "RECORD", {("generic", routes.ANY, routes.ANY): routes.Record(8, 48, 40, 0.2, 20),
+                                           ("generic", routes.ANY, "sort"): routes.Record(8, 8, 8, 0.6, 0),
+                                           ("generic", routes.ANY, "gmphd"): routes.Record(8, 8, 4, -2.9, 8)})
+    assert routes.caution("generic", routes.ANY, "sort") is None  # held for SORT
+    assert routes.caution("generic", routes.ANY, "gmphd").startswith(
+        "on the shared sequences (8 MOT15 sequences), gmphd specs tuned on a generic scenario kept a median -2.90")
+    assert "prefer them" in routes.caution("generic", routes.ANY, "gmphd")
+    assert "specs of the measured trackers (iou was not measured) tuned on a generic scenario kept a median 0.20" \
+        in routes.caution("generic", routes.ANY, "iou")
+    assert "20 of 48 lost" in routes.caution("generic", routes.ANY)
 
 
 def test_tune_warns_once_per_route_that_did_not_hold(monkeypatch, capsys):
-    monkeypatch.setattr(routes, "RECORD", {("generic", routes.ANY): routes.Record(8, 16, 10, 0.2, 5)})
+    monkeypatch.setattr(routes, "RECORD", {("generic", routes.ANY, routes.ANY): routes.Record(8, 16, 10, 0.2, 5)})
     assert cli.main(["tune", "sort", "--on", "crossing,books", "--trials", "2", "--json",
                      "--config", "env.max_steps=10"]) == 0
     err = capsys.readouterr().err
-    assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs tuned on a generic scenario kept a "
-                     "median 0.20") == 1
+    assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs of the measured trackers (sort was "
+                     "not measured) tuned on a generic scenario kept a median 0.20") == 1

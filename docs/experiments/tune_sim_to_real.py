@@ -122,8 +122,8 @@ def record(rows: list[dict], work: Path) -> str:
     """The routes' record of `rows` as RECORD's Python text: the scene's per the camera kind its fit found (the scene
     files in `work`)."""
     kinds = {r["sequence"]: camera_kind((work / f"scene_{r['sequence']}.toml").read_text()) for r in rows}
-    return "RECORD = {\n" + "".join(f'    ("{route}", "{kind}"): {value!r},\n'
-                                     for (route, kind), value in records(rows, kinds).items()) + "}"
+    return "RECORD = {\n" + "".join(f'    ("{route}", "{kind}", "{tracker}"): {value!r},\n'
+                                     for (route, kind, tracker), value in records(rows, kinds).items()) + "}"
 
 
 def table(rows: list[dict], metric: str) -> str:

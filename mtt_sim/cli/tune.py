@@ -74,7 +74,7 @@ def run(args) -> int:
     if dry_run(args, work):
         return 0
     announce(work)
-    _caution(args.on, overrides)
+    _caution(args.spec, args.on, overrides)
     from mtt_sim.lab import tune
 
     try:
@@ -110,12 +110,15 @@ def run(args) -> int:
     return 0
 
 
-def _caution(sources: list[str], overrides: dict) -> None:
-    """Warn, once per route, where tuning in simulation has not held on real video (`routes.RECORD`)."""
+def _caution(spec: str, sources: list[str], overrides: dict) -> None:
+    """Warn, once per route, where tuning the tracker of `spec` in simulation has not held on real video
+    (`routes.RECORD`)."""
     from mtt_sim.lab import routes
+    from mtt_sim.trackers import TrackerSpec
 
+    tracker = TrackerSpec.of(spec).registered
     taken = {routes.route_of(source, overrides) for source in sources} - {None}
-    for line in sorted(filter(None, {routes.caution(*route) for route in taken})):
+    for line in sorted(filter(None, {routes.caution(*route, tracker) for route in taken})):
         print(f"mtt-sim tune: warning: {line}", file=sys.stderr)
 
 
