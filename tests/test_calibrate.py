@@ -63,6 +63,9 @@ def test_the_twin_of_a_twin_has_the_data_statistics_and_its_table_loads(twin, tm
     c = calibrate.calibrate([twin], seeds=2)
     for key in ("P(miss)", "P(miss | miss)", "mean miss run"):
         assert c.twin[key] == pytest.approx(c.data[key], rel=0.1), key
+    # the people stand still, boxed exactly, so the fitted box noise alone makes the twin's boxes jump as the data's
+    for key in ("box jitter, centre x", "box jitter, height"):
+        assert c.twin[key] == pytest.approx(c.data[key], rel=0.1), key
     # a site held beside a person also ends when the person leaves (here every 100 frames), which the fit reads as a
     # shorter site life: known to cost about a tenth of the false positives
     assert c.twin["false positives per frame"] == pytest.approx(c.data["false positives per frame"], rel=0.15)
@@ -83,6 +86,20 @@ def test_association_counts_true_detections_outliers_and_false_positives():
     assert a.hit.tolist() == [True, False] and a.detected.tolist() == [True, True]
     assert sorted(a.det_kind.tolist()) == [0, 1, 2]
     assert a.iou[0] == pytest.approx(180 / 220)
+
+
+def test_box_jitter_is_the_median_second_difference_over_the_height():
+    """One still person, detected in four frames in a row with heights 100, 110, 100, 110 and the centre 0, 2, 0, 2
+    px off: the second differences over three frames are -20 / 110 and 20 / 100 (height), -4 / 110 and 4 / 100 (x)."""
+    truths, dets = [], []
+    for f, (dh, dx) in enumerate([(0, 0), (10, 2), (0, 0), (10, 2)]):
+        box = np.array([[100.0, 50.0, 40.0, 100.0]])
+        truths.append(Truth(ids=np.array([1]), boxes=box, visibility=np.ones(1), visible_boxes=box,
+                            depth=np.zeros(1), labels=np.array([1]), pieces=np.zeros((0, 5))))
+        dets.append(np.array([[100.0 + dx, 50.0, 40.0, 100.0 + dh, 0.9]]))
+    got = calibrate.statistics(calibrate.associate(truths, dets))
+    assert got["box jitter, height"] == pytest.approx((20 / 110 + 20 / 100) / 2)
+    assert got["box jitter, centre x"] == pytest.approx((4 / 110 + 4 / 100) / 2)
 
 
 def test_run_lengths_break_where_the_chain_breaks():

@@ -321,6 +321,7 @@ def statistics(a: Associated) -> dict:
                 "false positives in runs > 1 (share)": lengths[lengths > 1].sum() / max(lengths.sum(), 1),
                 "false positives beside a person (share)": a.det_near[false].mean() if false.any() else math.nan,
                 "mean IoU of true detections": np.nanmean(a.iou[true]) if true.any() else math.nan,
+                **dict(zip(("box jitter, centre x", "box jitter, height"), _jitter(a, order, cont))),
                 "average precision": average_precision(a.det_conf, a.det_kind == 0, len(a.frame)),
                 "precision, lowest fifth of confidences": _low_precision(a.det_conf, a.det_kind == 0),
                 "confidence, true (mean)": np.nanmean(a.conf[true]) if true.any() else math.nan,
@@ -328,6 +329,19 @@ def statistics(a: Associated) -> dict:
                 "confidence, false (mean)": a.det_conf[false].mean() if false.any() else math.nan,
                 "confidence, false (std)": a.det_conf[false].std() if false.any() else math.nan})
     return {k: float(v) for k, v in out.items()}
+
+
+def _jitter(a: Associated, order: np.ndarray, cont: np.ndarray) -> tuple[float, float]:
+    """How much a person's true detections jump from frame to frame: the median |second difference| of their centre
+    x and of their height over three frames in a row, over the height. Detections against the ground truth count the
+    annotators' jitter as the detector's; this, read off the detections alone, does not."""
+    hit, box = a.hit[order], a.match[order]
+    three = hit[:-2] & hit[1:-1] & hit[2:] & cont[1:-1] & cont[2:]  # rows i, i+1, i+2: one person, frames in a row
+    if not three.any():
+        return math.nan, math.nan
+    centre, height = box[:, 0] + box[:, 2] / 2, box[:, 3]
+    second = lambda v: (v[:-2] - 2 * v[1:-1] + v[2:])[three] / height[1:-1][three]  # noqa: E731
+    return float(np.median(np.abs(second(centre)))), float(np.median(np.abs(second(height))))
 
 
 def _low_precision(conf: np.ndarray, true: np.ndarray, share: float = 0.2) -> float:
