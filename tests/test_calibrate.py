@@ -2,6 +2,7 @@
 
 import hashlib
 import json
+import shutil
 
 import gymnasium as gym
 import numpy as np
@@ -63,9 +64,11 @@ def test_the_twin_of_a_twin_has_the_data_statistics_and_its_table_loads(twin, tm
     c = calibrate.calibrate([twin], seeds=2)
     for key in ("P(miss)", "P(miss | miss)", "mean miss run"):
         assert c.twin[key] == pytest.approx(c.data[key], rel=0.1), key
-    # the people stand still, boxed exactly, so the fitted box noise alone makes the twin's boxes jump as the data's
+    # the people stand still, boxed exactly: the per-frame noise matched to the jitter stays the known one
     for key in ("box jitter, centre x", "box jitter, height"):
         assert c.twin[key] == pytest.approx(c.data[key], rel=0.1), key
+    for key in ("box_noise", "box_size_noise"):
+        assert c.sensor[key] == pytest.approx(KNOWN[key], abs=0.008), key
     # a site held beside a person also ends when the person leaves (here every 100 frames), which the fit reads as a
     # shorter site life: known to cost about a tenth of the false positives
     assert c.twin["false positives per frame"] == pytest.approx(c.data["false positives per frame"], rel=0.15)
@@ -86,6 +89,25 @@ def test_association_counts_true_detections_outliers_and_false_positives():
     assert a.hit.tolist() == [True, False] and a.detected.tolist() == [True, True]
     assert sorted(a.det_kind.tolist()) == [0, 1, 2]
     assert a.iou[0] == pytest.approx(180 / 220)
+
+
+def test_the_annotators_jitter_is_not_counted_twice(twin, tmp_path):
+    """The twin's detections beside a ground truth whose boxes jitter (1 % of the height a frame, as an annotator's
+    might). The residuals' moments count that jitter as the detector's, and a twin built on the jittering truth then
+    has it twice: its boxes jump more than the detections. Matched to the detections' own jitter, they jump as much."""
+    shaky = tmp_path / "shaky"
+    shutil.copytree(twin, shaky)
+    gt = np.loadtxt(shaky / "gt" / "gt.txt", delimiter=",")
+    gt[:, 2:6] += np.random.default_rng(0).normal(0.0, 0.01, (len(gt), 4)) * gt[:, 5:6]
+    np.savetxt(shaky / "gt" / "gt.txt", gt, delimiter=",", fmt="%.3f")
+    source = calibrate.read(shaky)
+    moments = calibrate.fit(source.associated)
+    matched = calibrate.calibrate([shaky], seeds=1)
+    twice = calibrate.twin_statistics([source], moments, 1)
+    for key, noise in zip(("box jitter, centre x", "box jitter, height"), ("box_noise", "box_size_noise")):
+        assert twice[key] > 1.1 * matched.data[key], key
+        assert matched.twin[key] == pytest.approx(matched.data[key], rel=0.05), key
+        assert matched.sensor[noise] < moments[noise], noise
 
 
 def test_box_jitter_is_the_median_second_difference_over_the_height():

@@ -10,7 +10,8 @@ The fit, per part of the model (`mtt_sim.sim.sensor`):
   outliers: their share of the detections after a true one, and after anything else;
 - boxes: matched moments of the true detections' residuals (offset in box sizes, log size ratio): mean log size is
   box_scale; variance, lag-1 and lag-2 covariance of a person's residuals give the AR(1) drift and the per-frame
-  noise; outliers' share and spread;
+  noise, then the per-frame noise matched to how much the detections jump from frame to frame (`fit_jitter`: the
+  annotators' jitter is not the detector's); outliers' share and spread;
 - false positives: linked frame to frame (IoU >= 0.5) into runs; the number of runs per frame, their mean length
   and the share of one-frame runs give fresh clutter, the site birth rate and the site life (matched moments);
   the share of runs that overlap a person (IoU >= 0.1) is site_near;
@@ -38,7 +39,7 @@ from mtt_sim.core.frame import Truth
 from mtt_sim.real.sequence import Recording, SequenceConfig
 from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.sensor import log_height, twin_sensor
-from mtt_sim.sim2real import fit_confidences, truth_statistics
+from mtt_sim.sim2real import fit_confidences, fit_jitter, truth_statistics
 
 MATCH_IOU = 0.5     # a true detection
 OUTLIER_IOU = 0.3   # a detection of the person with a poor box
@@ -131,6 +132,12 @@ def _chains(a: Associated) -> tuple[np.ndarray, np.ndarray]:
     cont = np.zeros(len(order), bool)
     cont[1:] = (a.ident[order][1:] == a.ident[order][:-1]) & (a.frame[order][1:] == a.frame[order][:-1] + 1)
     return order, cont
+
+
+def _jitter(a: Associated) -> tuple[float, float]:
+    """`fit_jitter.jitter` of the true detections: how much their boxes jump from frame to frame."""
+    order, cont = _chains(a)
+    return fit_jitter.jitter(a.hit[order], a.match[order], cont)
 
 
 def run_lengths(values: np.ndarray, cont: np.ndarray) -> np.ndarray:
@@ -321,7 +328,7 @@ def statistics(a: Associated) -> dict:
                 "false positives in runs > 1 (share)": lengths[lengths > 1].sum() / max(lengths.sum(), 1),
                 "false positives beside a person (share)": a.det_near[false].mean() if false.any() else math.nan,
                 "mean IoU of true detections": np.nanmean(a.iou[true]) if true.any() else math.nan,
-                **dict(zip(("box jitter, centre x", "box jitter, height"), _jitter(a, order, cont))),
+                **dict(zip(fit_jitter.NAMES, _jitter(a))),
                 "average precision": average_precision(a.det_conf, a.det_kind == 0, len(a.frame)),
                 "precision, lowest fifth of confidences": _low_precision(a.det_conf, a.det_kind == 0),
                 "confidence, true (mean)": np.nanmean(a.conf[true]) if true.any() else math.nan,
@@ -329,19 +336,6 @@ def statistics(a: Associated) -> dict:
                 "confidence, false (mean)": a.det_conf[false].mean() if false.any() else math.nan,
                 "confidence, false (std)": a.det_conf[false].std() if false.any() else math.nan})
     return {k: float(v) for k, v in out.items()}
-
-
-def _jitter(a: Associated, order: np.ndarray, cont: np.ndarray) -> tuple[float, float]:
-    """How much a person's true detections jump from frame to frame: the median |second difference| of their centre
-    x and of their height over three frames in a row, over the height. Detections against the ground truth count the
-    annotators' jitter as the detector's; this, read off the detections alone, does not."""
-    hit, box = a.hit[order], a.match[order]
-    three = hit[:-2] & hit[1:-1] & hit[2:] & cont[1:-1] & cont[2:]  # rows i, i+1, i+2: one person, frames in a row
-    if not three.any():
-        return math.nan, math.nan
-    centre, height = box[:, 0] + box[:, 2] / 2, box[:, 3]
-    second = lambda v: (v[:-2] - 2 * v[1:-1] + v[2:])[three] / height[1:-1][three]  # noqa: E731
-    return float(np.median(np.abs(second(centre)))), float(np.median(np.abs(second(height))))
 
 
 def _low_precision(conf: np.ndarray, true: np.ndarray, share: float = 0.2) -> float:
@@ -451,6 +445,8 @@ def calibrate(folders: Sequence[str | Path], seeds: int = 3, progress: bool = Fa
         except (ValueError, RuntimeError) as err:  # too few or too alike detections for a fit: say whose
             raise ValueError(f"{', '.join(map(str, folders))}: the detector cannot be fitted to these detections "
                              f"({err})") from None
+        sensor = fit_jitter.match_noise(sensor, _jitter(together), lambda keys: _jitter(
+            pooled([associate(src.truths, twin_detections(src, keys, 0)) for src in sources])))
         bar.update()
         twin = twin_statistics(sources, sensor, seeds, bar)
     return Calibration(sensor, statistics(together), twin, tuple(str(f) for f in folders), len(together.frame),
