@@ -221,8 +221,8 @@ def test_validate_compares_real_and_twin_metrics_for_every_twin(two_sequences):
 def test_validate_judges_the_label_free_fitted_scene_as_its_own_run_would(two_sequences, tmp_path, capsys):
     v = validate.validate(two_sequences, ("sort",), seeds=1, scene=True)
     assert {k[0] for k in v.twin} == {t.name for t in validate.TWINS + (validate.SCENE,)} and not v.failed
-    # by hand: Seq0's scene, fitted to its detections with the detector fitted on Seq1, and SORT on its seed 0
-    others = calibrate.fit(calibrate.pooled([calibrate.read(two_sequences[1]).associated]))
+    # by hand: Seq0's scene, fitted to its detections with the detector calibrate fits on Seq1, and SORT on its seed 0
+    others = calibrate.calibrate([two_sequences[1]], seeds=1).sensor
     scene = tmp_path / "scene.toml"
     scene.write_text(fit_scene(two_sequences[0], others, seeds=())[3])
     assert v.twin[validate.SCENE.name, "Seq0", "sort"]["MOTA"] == run_episode(str(scene), "sort", 0)["metrics"]["MOTA"]

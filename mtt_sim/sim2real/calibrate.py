@@ -441,16 +441,22 @@ def calibrate(folders: Sequence[str | Path], seeds: int = 3, progress: bool = Fa
         together = pooled([src.associated for src in sources])
         bar.set_description("fitting the detector")
         try:
-            sensor = fit(together)
+            sensor = fitted(sources)
         except (ValueError, RuntimeError) as err:  # too few or too alike detections for a fit: say whose
             raise ValueError(f"{', '.join(map(str, folders))}: the detector cannot be fitted to these detections "
                              f"({err})") from None
-        sensor = fit_jitter.match_noise(sensor, _jitter(together), lambda keys: _jitter(
-            pooled([associate(src.truths, twin_detections(src, keys, 0)) for src in sources])))
         bar.update()
         twin = twin_statistics(sources, sensor, seeds, bar)
     return Calibration(sensor, statistics(together), twin, tuple(str(f) for f in folders), len(together.frame),
                        len(together.det_frame))
+
+
+def fitted(sources: Sequence[Source]) -> dict:
+    """The detector fitted to these sequences' detections together: `fit`, then its per-frame box noise matched to
+    how much the detections jump from frame to frame (`fit_jitter`, the twin run on the same people)."""
+    together = pooled([src.associated for src in sources])
+    return fit_jitter.match_noise(fit(together), _jitter(together), lambda keys: _jitter(
+        pooled([associate(src.truths, twin_detections(src, keys, 0)) for src in sources])))
 
 
 def pooled(parts: Sequence[Associated]) -> Associated:

@@ -69,8 +69,8 @@ def validate(folders: Sequence[str | Path], tracker_specs: Sequence[str] = TRACK
     sources = [calibrate.read(f) for f in folders]
     names = tuple(Path(f).name for f in folders)
     twins = tuple(t for t in TWINS + ((SCENE,) if scene else ()) if len(sources) > 1 or not t.leave_one_out)
-    here = [calibrate.fit(src.associated) for src in sources]
-    others = [calibrate.fit(calibrate.pooled([o.associated for j, o in enumerate(sources) if j != i]))
+    here = [calibrate.fitted([src]) for src in sources]
+    others = [calibrate.fitted([o for j, o in enumerate(sources) if j != i])
               if len(sources) > 1 else None for i in range(len(sources))]
     sensors = {(t.name, i): {**(others[i] if t.leave_one_out else here[i]), "memory": t.memory}
                for t in twins for i in range(len(sources))}
