@@ -99,12 +99,9 @@ def camera_kind(scene: str) -> str:
 def caution(route: str, kind: str, tracker: str = ANY) -> str | None:
     """The line to show a user tuning `tracker` (a registered name) by `route` on a camera of `kind`, or None where
     the record says the route held: the tracker's own record, else the measured trackers' pooled one."""
-    record = RECORD.get((route, kind, tracker))
-    whose = f"{tracker} specs" if record and tracker != ANY else "specs"
-    if record is None:
-        record = RECORD.get((route, kind, ANY))
-        if record is not None and tracker != ANY:
-            whose = f"specs of the measured trackers ({tracker} was not measured)"
+    record, whose = RECORD.get((route, kind, tracker)), "specs" if tracker == ANY else f"{tracker} specs"
+    if record is None and tracker != ANY:
+        record, whose = RECORD.get((route, kind, ANY)), f"specs of the measured trackers ({tracker} was not measured)"
     where = "the shared sequences" if kind == ANY else f"the shared {kind} cameras"
     if record is None:
         return (f"tuning on {NAMES[route]} has not been measured against real labels on {where}: check the tuned spec "
