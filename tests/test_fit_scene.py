@@ -296,3 +296,50 @@ def test_refine_keeps_the_fits_noise_where_the_tracklets_are_too_few_to_read_a_d
     # with eight people (560 windows) the same scene's noise is deflated, as in the test above
     many = fit_motion.tracklet_motion(straight_walkers(0.5)[0], LONG, RATE)
     assert fit_motion.refine(raw, many, scene, LONG, RATE, seeds=(0,))[0]["walk"]["noise"] == pytest.approx(0.01)
+
+
+FAR, AHEAD = -0.5, 0.3        # a horizon a third of the way down; a person at the bottom row grows 30 % a second
+
+
+def ground_seen_going_forward(ahead=AHEAD, frames=LONG):
+    """Ten people standing on the ground, seen by a camera going forward at `ahead` (`mtt_sim.sim.forward`): each
+    box's height is 200 px times the depth factor at its feet, so the height line gives the horizon back; a person is
+    kept while the feet are inside the picture."""
+    from mtt_sim.sim import forward
+
+    rng = np.random.default_rng(5)
+    pos = np.c_[rng.uniform(60, W - 60, 10), rng.uniform(0.45 * H, 0.75 * H, 10)]
+    rows = []
+    for f in range(frames):
+        h = 200.0 * (FAR + (1 - FAR) * pos[:, 1] / H)
+        for (x, y), hi in zip(pos, h):
+            if 0 < x < W and y < H:
+                rows.append((f + 1, float(x - 0.2 * hi), float(y - hi), float(0.4 * hi), float(hi), 0.9))
+        pos = forward.flow(pos, (W, H), FAR, ahead / RATE)
+    return rows
+
+
+def test_a_camera_going_forward_is_read_from_the_tracklets_growth_and_taken_out_of_the_walk(tmp_path):
+    from mtt_sim.sim2real import fit_forward, fit_motion
+
+    raw, rows, info = fitted(write_sequence(tmp_path / "seq", ground_seen_going_forward(), size=(W, H)))
+    assert raw["world"]["far_scale"] == pytest.approx(FAR, abs=0.02)  # kept below 0: the horizon inside the picture
+    assert raw["render"]["camera_forward"] == pytest.approx(AHEAD, rel=0.1)
+    tracks = fit_motion.track_rows(fit_motion.frames_of(rows, info.length))
+    assert fit_forward.evidence(fit_forward.windows(tracks, W, RATE)) > 0.95
+    # nobody walks: with the flow taken out, the feet stay where they were (SORT's boxes lag a little as they grow)
+    still = fit_forward.without(tracks, (W, H), FAR, AHEAD, RATE)
+    assert np.median([np.ptp(r[:, 1:3], axis=0).max() / r[0, 3] for r in still.values()]) < 0.1
+    walk, seen = raw["walk"], fit_motion.fit(rows, info)["walk"]  # the second as if the ground were flat
+    assert walk["stop_rate"] / (walk["stop_rate"] + walk["go_rate"]) > 0.9 and seen["stop_rate"] == 0.0
+    entry = [d for d in raw["doors"] if d["role"] == "entry"]  # the ground comes into view across the band
+    assert len(entry) == 1 and entry[0]["rect"][2] == W
+
+
+def test_walkers_on_a_still_camera_show_no_forward_motion(tmp_path):
+    from mtt_sim.sim2real import fit_forward, fit_motion
+
+    rows, info = fit_scene.link_sequence(write_sequence(tmp_path / "seq", moving_people(), size=(W, H)))
+    tracks = fit_motion.track_rows(fit_motion.frames_of(rows, info.length))
+    assert abs(fit_forward.evidence(fit_forward.windows(tracks, W, RATE))) < fit_forward.MOVING_R
+    assert "camera_forward" not in fit_motion.fit(rows, info, 0.2)["render"]

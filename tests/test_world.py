@@ -8,7 +8,8 @@ from hypothesis import strategies as st
 from helpers import BOOKS_WITH_DECOY, still, tiny
 from mtt_sim.env import NO_TRACKS, TrackingEnv
 from mtt_sim.sim.scenario import load
-from mtt_sim.sim.world import World, _SpotGrid
+from mtt_sim.sim.spots import SpotGrid
+from mtt_sim.sim.world import World
 
 
 def world(sc, seed=0):
@@ -132,7 +133,7 @@ def test_manoeuvring_targets_turn_and_stop():
 @given(st.lists(st.tuples(st.floats(0, 100), st.floats(0, 100), st.floats(0.5, 15), st.integers(0, 1)), max_size=40),
        st.floats(-10, 110), st.floats(-10, 110), st.floats(0.5, 15), st.integers(0, 1))
 def test_spot_grid_answers_as_testing_every_placed_target(placed, x, y, radius, layer):
-    grid = _SpotGrid(cell=12.0)
+    grid = SpotGrid(cell=12.0)
     for px, py, half, lay in placed:
         grid.add(lay, np.array([px, py]), half)
     same = np.array([(px, py, half) for px, py, half, lay in placed if lay == layer]).reshape(-1, 3)

@@ -103,7 +103,9 @@ class WorldConfig:
     max_alive: int = setting(1000, "no births while this many targets are alive (at most the label map's 65535)", "targets", 1,
                           65535)
     max_births: int = setting(-1, "total births over the episode, -1 = unlimited", "targets", -1, 1000000)
-    far_scale: float = setting(0.4, "standing: size factor at the top of the world relative to the bottom", "", 0.05, 1.0)
+    far_scale: float = setting(0.4, "standing: size factor at the top of the world relative to the bottom; below 0 the "
+                               "horizon lies inside the world, at the row where it is 0 (a camera at people's height)",
+                               "", -5.0, 1.0)
     frame_rate: float = setting(25.0, "frames per second of the simulated video: the walking model's seconds and the "
                                 "env's clock follow it (the other motion keys are per frame)", "1/s", 1.0, 240.0)
     carry_frames: int = setting(0, "topdown: a target completely covered by a moving target of a higher layer rides with it "
@@ -159,6 +161,11 @@ class RenderConfig:
                                   "width/frame", 0.0, 0.01)
     still_jitter_corr: float = setting(0.258, "still: frame-to-frame correlation of that shift", "", 0.0, 0.999)
     still_tail: float = setting(1.8, "still: Student-t degrees of freedom of the jitter's innovations", "", 1.0, 1000.0)
+    camera_forward: float = setting(0.0, "standing: the camera is driven or carried forward over the ground, and "
+                                    "everyone on it flows out from the horizon's middle as in a pinhole camera moving "
+                                    "along its axis: the rate at which a person at the bottom row grows (a person at "
+                                    "depth factor s grows s times as fast); 0 = not at all (mtt_sim/sim/forward.py)",
+                                    "1/s", 0.0, 5.0)
 
 
 @dataclass(frozen=True)

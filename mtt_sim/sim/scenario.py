@@ -72,6 +72,10 @@ def _check_references(sc: Scenario, where: str) -> Scenario:
     if sc.sensor.model == "foreground" and sc.render.camera in ("pan", "follow"):
         raise ConfigError(f"{where}: sensor.model = 'foreground' needs a static or shaking camera, not render.camera = "
                           f"{sc.render.camera!r}")
+    if sc.render.camera_forward > 0 and (sc.world.projection != "standing" or sc.world.far_scale >= 1.0):
+        raise ConfigError(f"{where}: render.camera_forward = {sc.render.camera_forward:g} needs a ground in perspective: "
+                          f"world.projection = 'standing' and world.far_scale < 1, not {sc.world.projection!r} and "
+                          f"{sc.world.far_scale:g}")
     return _check_budget(sc, where)
 
 

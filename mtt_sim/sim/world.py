@@ -13,20 +13,22 @@ up the image shrinks and slows down as a real one would.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 import pymunk
 import pymunk.batch as pbatch
 
+from mtt_sim.sim import forward
 from mtt_sim.sim.config import MOTIONS, TEXTURES, Scenario
+from mtt_sim.sim.spots import SpotGrid
 from mtt_sim.sim.walkers import Walkers
 
 WALL_BIT = 1 << 31
 _FREE, _FOR_GOOD, _LEFT = 0, -1, -2  # carry_left beside the frames left to ride: free, a carried group's, just left
 _FIELDS = pbatch.BodyFields.BODY_ID | pbatch.BodyFields.POSITION | pbatch.BodyFields.VELOCITY
 _WALL = 200.0  # wall thickness, px
+MIN_DEPTH = 0.02  # the smallest size factor: a far_scale below 0 puts the horizon inside the world
 _EXIT_MIN_AGE = 10  # frames a target must have lived before an exit door absorbs it (doors with role "both")
 
 
@@ -78,17 +80,19 @@ class World:
                        for k in ("accel", "speed", "max_speed", "turn_prob", "stop_prob")}
         self._exits = [d for d in scenario.doors if d.role in ("exit", "both")]
         self._walk = Walkers(scenario.walk, scenario.world.frame_rate) if scenario.walk.model == "langevin" else None
+        self._forward = scenario.render.camera_forward / scenario.world.frame_rate  # the camera's forward step
         self._populate()
         self._sync_order()
 
     # ------------------------------------------------------------ geometry
 
     def depth_scale(self, y: np.ndarray) -> np.ndarray:
-        """Size factor of a footprint at world row y: 1 at the bottom, `far_scale` at the top (standing only)."""
+        """Size factor of a footprint at world row y: 1 at the bottom, `far_scale` at the top (standing only), and
+        never below MIN_DEPTH (at and above a horizon inside the world)."""
         if not self.standing:
             return np.ones_like(y)
         f = self.sc.world.far_scale
-        return f + (1.0 - f) * np.clip(y / self.extent[1], 0.0, 1.0)
+        return np.maximum(f + (1.0 - f) * np.clip(y / self.extent[1], 0.0, 1.0), MIN_DEPTH)
 
     def boxes(self) -> np.ndarray:
         """Drawn extent of every target, (n, 4) x, y, w, h in world pixels, with the gait applied."""
@@ -142,7 +146,7 @@ class World:
     def _populate(self):
         """Place every group's initial targets, carriers before the targets they carry; linear in their number."""
         order = sorted(range(len(self.sc.groups)), key=lambda i: self.sc.groups[i].motion == "carried")
-        grid = _SpotGrid(max(max(g.size) for g in self.sc.groups))
+        grid = SpotGrid(max(max(g.size) for g in self.sc.groups))
         for gi in order:
             g = self.sc.groups[gi]
             if g.motion == "carried":
@@ -159,7 +163,7 @@ class World:
                 grid.add(g.layer, pos, 0.5 * size.max())
         self._flush()
 
-    def _free_spot(self, g, region, grid: "_SpotGrid", tries: int = 20) -> np.ndarray:
+    def _free_spot(self, g, region, grid: "SpotGrid", tries: int = 20) -> np.ndarray:
         """A point in `region` (its low and high corners) whose footprint does not overlap a placed target of the same
         layer, if one is found."""
         radius = 0.5 * max(g.size)
@@ -297,8 +301,19 @@ class World:
                 self._pin_carried()
             if self._picks_up:
                 self._pick_up_and_leave()
+            if self._forward:
+                self._flow_forward()
         self._remove(self._leaving())
         self._spawn_births()
+
+    def _flow_forward(self):
+        """Move every target with the ground as the camera goes forward (`mtt_sim.sim.forward`)."""
+        self.pos = forward.flow(self.pos, self.extent, self.sc.world.far_scale, self._forward)
+        data = self._read_bodies()
+        data[self._rows, :2] = self.pos[self._row_slot]
+        buf = pbatch.Buffer()
+        buf.set_float_buf(data[:, :2].ravel())
+        pbatch.set_space_bodies(self.space, pbatch.BodyFields.POSITION, buf)
 
     def _carried(self) -> tuple[np.ndarray, np.ndarray]:
         """(slots of carried targets whose carrier is alive, their carriers' slots)."""
@@ -446,53 +461,20 @@ class World:
                 x, y, w, h = door.rect
                 pos = self.rng.uniform((x, y), (x + w, y + h))
                 heading = self.rng.uniform(0, 2 * math.pi)
-            self._spawn(gi, pos, self._initial_velocity(g, heading))
+            # under a camera going forward a door is ground coming into view, with people as they are (some waiting)
+            self._spawn(gi, pos, self._initial_velocity(g, heading), in_view=door is not None and bool(self._forward))
             self.births += 1
         if self.births != before:
             self._flush()
             self._sync_order()
 
     def _border_entry(self, g) -> tuple[np.ndarray, float]:
-        """A point on a random border (just outside it, or just inside where there are walls) and an inward heading."""
+        """A point on a random border (just outside it, or just inside where there are walls) and an inward heading;
+        the far border where the camera goes forward (the ground comes from there)."""
         w, h = self.extent
-        side = self.rng.choice(4, p=np.array([h, w, h, w]) / (2 * (w + h)))
+        side = 1 if self._forward else self.rng.choice(4, p=np.array([h, w, h, w]) / (2 * (w + h)))
         inset = 2.0 + 0.5 * max(g.size) if self.sc.world.walls else -0.5 * max(g.size)
         u = self.rng.random()
         pos, inward = [((inset, u * h), 0.0), ((u * w, inset), 90.0),
                        ((w - inset, u * h), 180.0), ((u * w, h - inset), 270.0)][side]
         return np.array(pos), math.radians(inward + self.rng.uniform(-45, 45))
-
-
-class _SpotGrid:
-    """Placed targets' centres and half-sizes in square cells per layer, so a free-spot test looks only at the
-    targets near the spot: the same answer as testing all of them, at a cost that does not grow with their number."""
-
-    def __init__(self, cell: float):
-        self.cell = max(float(cell), 1.0)
-        self.cells: dict[tuple, list] = {}
-        self.largest: dict[int, float] = {}  # the largest half-size placed on each layer
-
-    def add(self, layer: int, centre: np.ndarray, half: float):
-        cx, cy = (int(v // self.cell) for v in centre)
-        self.cells.setdefault((layer, cx, cy), []).append((centre[0], centre[1], half))
-        self.largest[layer] = max(self.largest.get(layer, 0.0), half)
-
-    def is_free(self, layer: int, p: np.ndarray, radius: float) -> bool:
-        """Whether a footprint of `radius` at p keeps clear of every target on `layer` (centre distance above the sum
-        of the two half-sizes). Cells are visited nearest first and the test stops at the first overlap."""
-        rings = int((radius + self.largest.get(layer, 0.0)) // self.cell) + 1  # cells that can hold a touching target
-        cx, cy = int(p[0] // self.cell), int(p[1] // self.cell)
-        for dx, dy in _nearest_first(rings):
-            placed = self.cells.get((layer, cx + dx, cy + dy))
-            if placed:
-                rows = np.array(placed)
-                if not (np.hypot(*(rows[:, :2] - p).T) > radius + rows[:, 2]).all():
-                    return False
-        return True
-
-
-@functools.cache
-def _nearest_first(rings: int) -> list[tuple[int, int]]:
-    """Cell offsets within `rings` of the centre cell, nearest first."""
-    offsets = [(dx, dy) for dx in range(-rings, rings + 1) for dy in range(-rings, rings + 1)]
-    return sorted(offsets, key=lambda d: abs(d[0]) + abs(d[1]))

@@ -45,6 +45,7 @@ import numpy as np
 from mtt_sim.sim import camera as cam
 from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.config import WalkConfig
+from mtt_sim.sim2real import fit_forward
 from mtt_sim.sim2real import fit_walkers as walkers_fit
 from mtt_sim.sim2real.motion import STANDING, track_rows, window_values
 
@@ -196,12 +197,20 @@ def _rates_from_share(frames, frame_rate: float) -> dict:
     return {"go_rate": round(go, 4), "stop_rate": round(min(go * standing / max(1 - standing, 0.05), 100.0), 4)}
 
 
-def fit(rows: np.ndarray, info) -> dict:
+def fit(rows: np.ndarray, info, far_scale: float = 1.0) -> dict:
     """The motion of the scene fitted to tracklet rows (frame, id, x, y, w, h) of a sequence with `info` (width,
-    height, frame_rate, length): {"world": {"frame_rate"}, "walk": the walking model's keys, "render": the camera's
-    keys, "camera": what was estimated (the evidence, the per-frame shifts, whether it moves)}."""
+    height, frame_rate, length), seen as a ground with `far_scale` (1: none in perspective, so no forward motion):
+    {"world": {"frame_rate"}, "walk": the walking model's keys, "render": the camera's keys, "camera": what was
+    estimated (the evidence, the per-frame shifts, whether it moves; the forward evidence and rate)}."""
     rate, length = float(info.frame_rate), int(info.length)
     tracks = track_rows(frames_of(rows, length))
+    ahead, pulled = 0.0, 0.0  # forward first: its flow is no common shift, and a walker's speed does not hold it
+    if far_scale < 1.0:
+        values = fit_forward.windows(tracks, info.width, rate)
+        pulled = fit_forward.evidence(values)
+        if pulled >= fit_forward.MOVING_R:
+            ahead = round(fit_forward.rate(values, info.height, far_scale), 4)
+            tracks = fit_forward.without(tracks, (info.width, info.height), far_scale, ahead, rate)
     shift, count = common_shift(tracks, length)
     evidence = camera_evidence(tracks, length, rate)
     moving = evidence["r"] >= MOVING_R and evidence["z"] >= MOVING_Z and evidence["common"] >= MIN_COMMON
@@ -218,10 +227,13 @@ def fit(rows: np.ndarray, info) -> dict:
     else:
         shift = np.zeros_like(shift)
         render = {"camera": "still"}
+    if ahead > 0:
+        render["camera_forward"] = ahead
     walkers = fit_walkers(frames_from_tracks(tracks, length), rate)
     walk = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in asdict(walkers).items() if k in WALK_KEYS}
     return {"world": {"frame_rate": rate}, "walk": walk, "render": render,
-            "camera": {**evidence, "moving": bool(moving), "shift": shift, "overlaps": count}}
+            "camera": {**evidence, "moving": bool(moving), "shift": shift, "overlaps": count, "forward_r": pulled,
+                       "forward": ahead}}
 
 
 def tracklet_motion(rows: np.ndarray, length: int, frame_rate: float) -> np.ndarray:
@@ -354,22 +366,24 @@ def _scaled(value: float, factor: float, key: str) -> float:
 
 
 def doors(width: float, height: float, size: float, rows: tuple[float, float], heading: float | None,
-          births: float) -> list[dict]:
+          births: float, ahead: bool = False) -> list[dict]:
     """Entry and exit doors at the left and right borders, four along each, spread over `rows` (the band of the
     people's feet, as shares of the height), entries just inside (sharing `births` a frame) and exits just outside
     (`size` px square): walkers, who head for a random exit, cross the scene at the depth where they walk and leave it
     (an exit outside that band would send them into or out of the picture's depth, where the perspective bends a
     straight walk; without exits the world's goal is a point inside it, where they would stay). Where the tracklets
     walk one way (`heading`, degrees, within 45 of across), people enter on the side they come from and leave on the
-    other; else on both."""
+    other; else on both. Where the camera goes forward (`ahead`), everyone enters through one door across the width
+    at the far edge of the band, for the ground comes from there and flows out past the borders."""
     across = None if heading is None else math.cos(math.radians(heading))
     going = ("right",) if across is not None and across > SIDEWAYS else ("left",) if across is not None and \
         across < -SIDEWAYS else ("left", "right")
     coming = [{"left": "right", "right": "left"}[g] for g in going] if len(going) == 1 else going
-    out = []
+    out = [{"rect": [0.0, rows[0] * height, width, (rows[1] - rows[0]) * height], "role": "entry",
+            "birth_rate": births}] if ahead else []
     for f in (1 / 8, 3 / 8, 5 / 8, 7 / 8):
         y = (rows[0] + f * (rows[1] - rows[0])) * height
-        for side in coming:
+        for side in coming * (not ahead):
             x = -0.5 * size if side == "left" else width
             out.append({"rect": [x, y - size / 4, 0.5 * size, 0.5 * size], "role": "entry",
                         "birth_rate": births / (4 * len(coming))})

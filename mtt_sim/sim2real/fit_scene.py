@@ -49,6 +49,7 @@ from mtt_sim.sim2real import fit_motion
 LINKER = "sort:min_hits=3,max_age=3"
 MIN_FRAMES = 5       # tracklets shorter than this are dropped (false positives, fragments)
 AGREE_DEG = 45.0     # headings within this of their mean agree
+FAR_LIMIT = -5.0     # the lowest far_scale the schema allows (a horizon inside the picture)
 MOVING = 0.2         # px/frame: slower tracklets have no heading
 STAT_NAMES = {"people": "people per frame", "births": "births per frame", "height": "median height (px)",
               "far_near": "far/near height ratio", "speed": "median speed (px/frame)"}
@@ -145,13 +146,16 @@ def fit(rows: np.ndarray, info) -> dict:
     a, b = _height_line(rows)
     aspect = float(np.median(rows[:, 4] / rows[:, 5]))
     standing = b > 0 and a + b * H > 0
+    moved = fit_motion.fit(rows, info, float(np.clip(a / (a + b * H), FAR_LIMIT, 0.999)) if standing else 1.0)
     if standing:
         near = a + b * H
-        far = float(np.clip(a / near, 0.05, 1.0))
+        # a camera going forward keeps the line's horizon, inside the picture where it is there: its flow is
+        # measured from it; a still one keeps far_scale at 0.05 or more, the range the earlier fits had
+        far = float(np.clip(a / near, FAR_LIMIT if "camera_forward" in moved["render"] else 0.05, 1.0))
         if far != a / near:  # clipped: the near height refitted (least squares) with far_scale held there
             g = far + (1.0 - far) * (rows[:, 3] + rows[:, 5]) / H
             near = float(g @ rows[:, 5] / (g @ g))
-        scale = np.clip((a + b * feet) / near, far, 1.0)
+        scale = np.clip((a + b * feet) / near, max(far, 0.05), 1.0)
         size = (aspect * near, near)
         world = {"projection": "standing", "far_scale": far}
     else:
@@ -171,8 +175,8 @@ def fit(rows: np.ndarray, info) -> dict:
              "motion": "cv", "speed": round(float(np.clip(np.median(speeds), 0.0, 200.0)), 3),
              "speed_jitter": round(float(np.clip(np.std(speeds) / max(np.mean(speeds), 1e-9), 0.0, 1.0)), 3),
              "heading": heading, "heading_jitter": jitter}
-    moved = fit_motion.fit(rows, info)
-    doors = fit_motion.doors(W, H, size[1], (region[1], region[3]), heading if jitter < 180 else None, births)
+    doors = fit_motion.doors(W, H, size[1], (region[1], region[3]), heading if jitter < 180 else None, births,
+                             ahead="camera_forward" in moved["render"])
     return {"name": _camel(info.name), "description": f"Fitted to the detections of {info.name} alone "
             "(mtt-sim fit-scene).", "world": {**world, **moved["world"]},
             "render": {"width": int(W), "height": int(H), **moved["render"]}, "walk": moved["walk"],
@@ -247,6 +251,8 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
               "Detector: " + ("the default." if sensor is None else f"the [sensor] table of {Path(sensor).name}."
                               if isinstance(sensor, (str, Path)) else "the one given."),
               f"Motion: walkers by walk.model = \"langevin\" at {info.frame_rate:g} fps; a {raw['render']['camera']} "
-              "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "") + ".",
+              "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "")
+              + (f", going forward ({raw['render']['camera_forward']:g}/s: the tracklets grow and slide outward)"
+                 if raw["render"].get("camera_forward") else "") + ".",
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]
     return raw, real, scene, scn.to_toml(raw, header)
