@@ -343,3 +343,12 @@ def test_walkers_on_a_still_camera_show_no_forward_motion(tmp_path):
     tracks = fit_motion.track_rows(fit_motion.frames_of(rows, info.length))
     assert abs(fit_forward.evidence(fit_forward.windows(tracks, W, RATE))) < fit_forward.MOVING_R
     assert "camera_forward" not in fit_motion.fit(rows, info, 0.2)["render"]
+
+
+def test_the_jitter_scales_the_detectors_frame_to_frame_noise_and_keeps_its_drift():
+    from mtt_sim.sim2real import fit_motion
+
+    raw = {"sensor": {"box_noise": 0.02, "box_size_noise": 0.05, "box_drift": 0.06, "box_size_drift": 0.1}}
+    sensor = fit_motion._detector_scaled(raw, 2.0)["sensor"]
+    assert sensor == {"box_noise": 0.04, "box_size_noise": 0.1, "box_drift": 0.06, "box_size_drift": 0.1}
+    assert fit_motion._detector_scaled(raw, 100.0)["sensor"]["box_noise"] == 0.08  # within NOISE_REACH (4)

@@ -48,7 +48,9 @@ def measure(folder: Path, sensor: str, scratch: Path) -> dict:
     render, walk = raw.get("render", {}), raw.get("walk", {})
     return {"real": real, "scene": scene, "pooled": {**motion.people(pooled, scene_rate), "crowd": crowd(pooled)},
             "rate": raw.get("world", {}).get("frame_rate", 25.0),
-            "camera": render.get("camera", "static"), "walk": walk.get("model", "off")}
+            "camera": render.get("camera", "static") + (f", forward {render['camera_forward']:g}/s"
+                                                        if render.get("camera_forward") else ""),
+            "walk": walk.get("model", "off")}
 
 
 def crowd(frames) -> float:
