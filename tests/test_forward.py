@@ -61,3 +61,12 @@ def test_people_seen_from_a_camera_going_forward_leave_the_view_sooner():
         return motion.people(frames, rate)["time in view"]
 
     assert in_view({"render.camera_forward": 0.6}) < 0.5 * in_view({})
+
+
+def test_the_forward_street_for_the_policy_keeps_a_crowd_that_comes_and_goes():
+    from helpers import EXPERIMENTS
+
+    frames, rate, _ = motion.scored_frames(str(EXPERIMENTS / "forward_street.toml"), steps=150)
+    assert rate == 14.0
+    assert 1.0 < motion.people(frames, rate)["time in view"] < 3.0  # people pass within seconds
+    assert np.mean([len(ids) for ids, _ in frames[-50:]]) >= 3  # and others come into view
