@@ -88,3 +88,10 @@ def test_tune_warns_once_per_route_that_did_not_hold(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs of the measured trackers (sort was "
                      "not measured) tuned on a generic scenario kept a median 0.20") == 1
+
+
+def test_a_scene_that_moves_or_goes_forward_is_a_walking_camera():
+    header = routes.FITTED_HEADER + "\n"
+    assert routes.camera_kind(header + '[render]\ncamera = "still"\n') == "still"
+    assert routes.camera_kind(header + '[render]\ncamera = "walking"\n') == "walking"
+    assert routes.camera_kind(header + '[render]\ncamera = "still"\ncamera_forward = 0.78\n') == "walking"

@@ -92,8 +92,10 @@ def route_of(source: str, overrides: Mapping[str, object] | None = None) -> tupl
 
 
 def camera_kind(scene: str) -> str:
-    """The kind of camera ("walking" or "still") of a fit-scene file's text: what its fit found."""
-    return "walking" if tomllib.loads(scene).get("render", {}).get("camera") == "walking" else "still"
+    """The kind of camera of a fit-scene file's text, as its fit found it: "walking" where it moves (a common shift,
+    or going forward), else "still"."""
+    render = tomllib.loads(scene).get("render", {})
+    return "walking" if render.get("camera") == "walking" or render.get("camera_forward", 0) > 0 else "still"
 
 
 def caution(route: str, kind: str, tracker: str = ANY) -> str | None:
