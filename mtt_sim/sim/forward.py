@@ -22,12 +22,18 @@ import numpy as np
 MAX_STEP = 0.5  # 1 - c s is held at this or above: a person within one step of the camera stays where that leaves them
 
 
+def depth(y: np.ndarray, height: float, far_scale: float) -> np.ndarray:
+    """The standing world's depth factor s(y) at feet rows `y` of a world `height` px high: 1 at the bottom row,
+    `far_scale` at the top, 0 at the horizon (negative above it)."""
+    return far_scale + (1.0 - far_scale) * y / height
+
+
 def flow(pos: np.ndarray, extent, far_scale: float, per_frame: float) -> np.ndarray:
     """Positions (n, 2) of feet on the ground of a world `extent` (width, height) with `far_scale` < 1, one frame after
     the camera moved forward by `per_frame` (camera_forward over the frame rate)."""
     width, height = extent
     horizon = -far_scale * height / (1.0 - far_scale)
-    s = far_scale + (1.0 - far_scale) * pos[:, 1] / height
+    s = depth(pos[:, 1], height, far_scale)
     grow = 1.0 / np.maximum(1.0 - per_frame * np.maximum(s, 0.0), MAX_STEP)
     focus = np.array([width / 2.0, horizon])
     return focus + (pos - focus) * grow[:, None]

@@ -91,8 +91,8 @@ class World:
         never below MIN_DEPTH (at and above a horizon inside the world)."""
         if not self.standing:
             return np.ones_like(y)
-        f = self.sc.world.far_scale
-        return np.maximum(f + (1.0 - f) * np.clip(y / self.extent[1], 0.0, 1.0), MIN_DEPTH)
+        h = self.extent[1]
+        return np.maximum(forward.depth(np.clip(y, 0.0, h), h, self.sc.world.far_scale), MIN_DEPTH)
 
     def boxes(self) -> np.ndarray:
         """Drawn extent of every target, (n, 4) x, y, w, h in world pixels, with the gait applied."""
@@ -296,20 +296,21 @@ class World:
         self.space.step(1.0)
         self.t += 1
         if len(self.ids):
-            self.pos = self._slot_view(self._read_bodies())[:, :2]
+            data = self._read_bodies()
+            self.pos = self._slot_view(data)[:, :2]
             if self._carrying:
                 self._pin_carried()
             if self._picks_up:
                 self._pick_up_and_leave()
             if self._forward:
-                self._flow_forward()
+                self._flow_forward(data)
         self._remove(self._leaving())
         self._spawn_births()
 
-    def _flow_forward(self):
-        """Move every target with the ground as the camera goes forward (`mtt_sim.sim.forward`)."""
+    def _flow_forward(self, data: np.ndarray):
+        """Move every target with the ground as the camera goes forward (`mtt_sim.sim.forward`); `data` is this step's
+        read of the bodies, whose rows that are not targets keep their place."""
         self.pos = forward.flow(self.pos, self.extent, self.sc.world.far_scale, self._forward)
-        data = self._read_bodies()
         data[self._rows, :2] = self.pos[self._row_slot]
         buf = pbatch.Buffer()
         buf.set_float_buf(data[:, :2].ravel())

@@ -51,7 +51,7 @@ def evidence(values: np.ndarray) -> float:
 def rate(values: np.ndarray, height: float, far_scale: float) -> float:
     """`render.camera_forward` (1/s): the median over `windows`' rows of the growth over the depth factor at the
     feet of a world `height` px high with `far_scale`; 0 where it is not positive."""
-    depth = np.maximum(far_scale + (1.0 - far_scale) * values[:, 3] / height, 0.05)
+    depth = np.maximum(forward.depth(values[:, 3], height, far_scale), 0.05)
     return max(0.0, float(np.median(values[:, 0] / depth)))
 
 

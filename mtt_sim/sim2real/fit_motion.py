@@ -45,7 +45,7 @@ import numpy as np
 from mtt_sim.sim import camera as cam
 from mtt_sim.sim import scenario as scn
 from mtt_sim.sim.config import WalkConfig
-from mtt_sim.sim2real import fit_forward
+from mtt_sim.sim2real import fit_forward, fit_jitter
 from mtt_sim.sim2real import fit_walkers as walkers_fit
 from mtt_sim.sim2real.motion import STANDING, track_rows, window_values
 
@@ -62,7 +62,7 @@ MAX_SEEDS = 12        # ... taking at most this many (a short sequence's scene g
 LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0),
           "speed": tuple(scn.setting_of("walk.speed")[1][end] for end in ("lo", "hi"))}
 REACH = {"noise": 10.0, "stop_rate": 10.0, "speed": 3.0}  # the refinement moves each at most this far from the fit
-NOISE_KEYS = ("box_noise", "box_size_noise")  # the detector's frame-to-frame noise, scaled to the jitter
+NOISE_KEYS = fit_jitter.KEYS  # the detector's frame-to-frame noise, scaled to the jitter as calibrate matches it
 NOISE_REACH = 4.0     # ... at most this far either way
 SIDEWAYS = math.cos(math.radians(45))  # a heading whose cosine is beyond this walks across (left or right)
 WALK_KEYS = ("model", "speed", "speed_jitter", "relax", "noise", "stand_noise", "stop_rate", "go_rate")
@@ -201,7 +201,7 @@ def fit(rows: np.ndarray, info, far_scale: float = 1.0) -> dict:
     """The motion of the scene fitted to tracklet rows (frame, id, x, y, w, h) of a sequence with `info` (width,
     height, frame_rate, length), seen as a ground with `far_scale` (1: none in perspective, so no forward motion):
     {"world": {"frame_rate"}, "walk": the walking model's keys, "render": the camera's keys, "camera": what was
-    estimated (the evidence, the per-frame shifts, whether it moves; the forward evidence and rate)}."""
+    estimated (the evidence, the per-frame shifts, whether it moves; the forward evidence)}."""
     rate, length = float(info.frame_rate), int(info.length)
     tracks = track_rows(frames_of(rows, length))
     ahead, pulled = 0.0, 0.0  # forward first: its flow is no common shift, and a walker's speed does not hold it
@@ -232,8 +232,7 @@ def fit(rows: np.ndarray, info, far_scale: float = 1.0) -> dict:
     walkers = fit_walkers(frames_from_tracks(tracks, length), rate)
     walk = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in asdict(walkers).items() if k in WALK_KEYS}
     return {"world": {"frame_rate": rate}, "walk": walk, "render": render,
-            "camera": {**evidence, "moving": bool(moving), "shift": shift, "overlaps": count, "forward_r": pulled,
-                       "forward": ahead}}
+            "camera": {**evidence, "moving": bool(moving), "shift": shift, "overlaps": count, "forward_r": pulled}}
 
 
 def tracklet_motion(rows: np.ndarray, length: int, frame_rate: float) -> np.ndarray:
@@ -375,17 +374,18 @@ def doors(width: float, height: float, size: float, rows: tuple[float, float], h
     (an exit outside that band would send them into or out of the picture's depth, where the perspective bends a
     straight walk; without exits the world's goal is a point inside it, where they would stay). Where the tracklets
     walk one way (`heading`, degrees, within 45 of across), people enter on the side they come from and leave on the
-    other; else on both. Where the camera goes forward (`ahead`), everyone enters through one door across the width
-    at the far edge of the band, for the ground comes from there and flows out past the borders."""
+    other; else on both. Where the camera goes forward (`ahead`), everyone enters through one door over the whole
+    band, across the width (people come into view ahead of the camera), and leaves as the ground flows them out."""
     across = None if heading is None else math.cos(math.radians(heading))
     going = ("right",) if across is not None and across > SIDEWAYS else ("left",) if across is not None and \
         across < -SIDEWAYS else ("left", "right")
     coming = [{"left": "right", "right": "left"}[g] for g in going] if len(going) == 1 else going
+    side_entries = () if ahead else coming
     out = [{"rect": [0.0, rows[0] * height, width, (rows[1] - rows[0]) * height], "role": "entry",
             "birth_rate": births}] if ahead else []
     for f in (1 / 8, 3 / 8, 5 / 8, 7 / 8):
         y = (rows[0] + f * (rows[1] - rows[0])) * height
-        for side in coming * (not ahead):
+        for side in side_entries:
             x = -0.5 * size if side == "left" else width
             out.append({"rect": [x, y - size / 4, 0.5 * size, 0.5 * size], "role": "entry",
                         "birth_rate": births / (4 * len(coming))})

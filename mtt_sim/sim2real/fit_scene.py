@@ -145,10 +145,10 @@ def fit(rows: np.ndarray, info) -> dict:
     start, end, c0, c1, feet = _tracklets(rows)
     a, b = _height_line(rows)
     aspect = float(np.median(rows[:, 4] / rows[:, 5]))
-    standing = b > 0 and a + b * H > 0
-    moved = fit_motion.fit(rows, info, float(np.clip(a / (a + b * H), FAR_LIMIT, 0.999)) if standing else 1.0)
+    near = a + b * H
+    standing = b > 0 and near > 0
+    moved = fit_motion.fit(rows, info, float(np.clip(a / near, FAR_LIMIT, 0.999)) if standing else 1.0)
     if standing:
-        near = a + b * H
         # a camera going forward keeps the line's horizon, inside the picture where it is there: its flow is
         # measured from it; a still one keeps far_scale at 0.05 or more, the range the earlier fits had
         far = float(np.clip(a / near, FAR_LIMIT if "camera_forward" in moved["render"] else 0.05, 1.0))
