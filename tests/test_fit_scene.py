@@ -246,6 +246,37 @@ def test_refine_sets_the_desired_speed_at_which_the_scenes_people_walk_as_the_se
     assert refined["walk"]["noise"] == pytest.approx(0.01)
 
 
+def walkers_and_standers(standing: int) -> tuple[np.ndarray, list]:
+    """Six people walking half a height a second and `standing` more who hold still, in every one of LONG frames."""
+    from mtt_sim.sim2real import fit_motion
+
+    rows = straight_walkers(0.5, people=6)[0]
+    if standing:
+        rows = np.r_[rows, straight_walkers(0.0, people=standing)[0] + [0, 100, 0, 300, 0, 0]]
+    return rows, fit_motion.frames_of(rows, LONG)
+
+
+def test_refine_matches_who_stands_in_the_picture_of_a_camera_going_forward_with_its_companions():
+    """Under a camera going forward the sequence's standing people walk with it (`fit_forward.companions`): the
+    refinement adds companions until the scene stands as the sequence does, and leaves the walkers' stop rate (whose
+    standing people would flow out with the ground) as fitted."""
+    from mtt_sim.sim2real import fit_motion
+
+    target = fit_motion.tracklet_motion(walkers_and_standers(2)[0], LONG, RATE)
+    assert target[2] == pytest.approx(0.25)
+
+    def scene(raw, seed):
+        return walkers_and_standers(raw["render"].get("camera_companions", 0))
+
+    raw = {"walk": {"model": "langevin", "speed": 0.5, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1, "relax": 0.5},
+           "render": {"camera_forward": 0.3}, "sensor": {"preset": "ideal"}}
+    refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))
+    assert refined["render"]["camera_companions"] == 2 and refined["walk"]["stop_rate"] == 0.1
+    flat = {**raw, "render": {}}  # a camera that does not go forward: the stop rate is the lever
+    refined, _ = fit_motion.refine(flat, target, scene, LONG, RATE, seeds=(0,))
+    assert "camera_companions" not in refined["render"] and refined["walk"]["stop_rate"] > 0.1
+
+
 def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequences(monkeypatch):
     """A fake scene whose tracklets deviate by sqrt(floor^2 + (k noise)^2) (the detector's deviation and the walkers'
     adding in squares): the refinement solves for the noise at which they deviate as the sequence's do."""
@@ -301,18 +332,20 @@ def test_refine_keeps_the_fits_noise_where_the_tracklets_are_too_few_to_read_a_d
 FAR, AHEAD = -0.5, 0.3        # a horizon a third of the way down; a person at the bottom row grows 30 % a second
 
 
-def ground_seen_going_forward(ahead=AHEAD, frames=LONG):
+def ground_seen_going_forward(ahead=AHEAD, frames=LONG, companions=0):
     """Ten people standing on the ground, seen by a camera going forward at `ahead` (`mtt_sim.sim.forward`): each
     box's height is 200 px times the depth factor at its feet, so the height line gives the horizon back; a person is
-    kept while the feet are inside the picture."""
+    kept while the feet are inside the picture. `companions` more walk with the camera, beside the middle column."""
     from mtt_sim.sim import forward
 
     rng = np.random.default_rng(5)
     pos = np.c_[rng.uniform(60, W - 60, 10), rng.uniform(0.45 * H, 0.75 * H, 10)]
+    along = np.c_[W / 2 + 80 * np.arange(companions), np.full(companions, 0.6 * H)]
     rows = []
     for f in range(frames):
-        h = 200.0 * (FAR + (1 - FAR) * pos[:, 1] / H)
-        for (x, y), hi in zip(pos, h):
+        seen = np.r_[pos, along]
+        h = 200.0 * (FAR + (1 - FAR) * seen[:, 1] / H)
+        for (x, y), hi in zip(seen, h):
             if 0 < x < W and y < H:
                 rows.append((f + 1, float(x - 0.2 * hi), float(y - hi), float(0.4 * hi), float(hi), 0.9))
         pos = forward.flow(pos, (W, H), FAR, ahead / RATE)
@@ -334,6 +367,18 @@ def test_a_camera_going_forward_is_read_from_the_tracklets_growth_and_taken_out_
     assert walk["stop_rate"] / (walk["stop_rate"] + walk["go_rate"]) > 0.9 and seen["stop_rate"] == 0.0
     entry = [d for d in raw["doors"] if d["role"] == "entry"]  # the ground comes into view across the band
     assert len(entry) == 1 and entry[0]["rect"][2] == W
+
+
+def test_people_who_hold_still_in_the_picture_of_a_camera_going_forward_walk_with_it(tmp_path):
+    from mtt_sim.sim2real import fit_forward
+
+    assert fit_forward.companions(np.r_[np.zeros(140), np.ones(500)], 110, 10) == 1  # 140 windows over 100 ends
+    assert fit_forward.companions(np.r_[np.zeros(40), np.ones(500)], 110, 10) == 0
+    raw = fitted(write_sequence(tmp_path / "two", ground_seen_going_forward(companions=2), size=(W, H)))[0]
+    assert raw["render"]["camera_forward"] == pytest.approx(AHEAD, rel=0.1)
+    assert raw["render"]["camera_companions"] == 2
+    assert "camera_companions" not in fitted(write_sequence(tmp_path / "none", ground_seen_going_forward(),
+                                                           size=(W, H)))[0]["render"]
 
 
 def test_walkers_on_a_still_camera_show_no_forward_motion(tmp_path):

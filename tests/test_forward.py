@@ -70,3 +70,25 @@ def test_the_forward_street_for_the_policy_keeps_a_crowd_that_comes_and_goes():
     assert rate == 14.0
     assert 1.0 < motion.people(frames, rate)["time in view"] < 3.0  # people pass within seconds
     assert np.mean([len(ids) for ids, _ in frames[-50:]]) >= 3  # and others come into view
+
+
+def test_the_cameras_companions_keep_their_place_while_the_ground_flows_out():
+    overrides = {"render.camera_forward": 0.6, "world.far_scale": -0.5, "walk.stop_rate": 0.0}
+    plain = World(load("mot17_like", overrides), np.random.default_rng(3))
+    w = World(load("mot17_like", {**overrides, "render.camera_companions": 2}), np.random.default_rng(3))
+    assert len(w.ids) == len(plain.ids) + 2 and w.pos[:-2] == pytest.approx(plain.pos)  # added, the rest as drawn
+    ids, start = w.ids[w.companion], w.pos[w.companion].copy()
+    assert np.abs(start[:, 0] / w.extent[0] - 0.5).max() <= 0.05  # beside the middle column, where the camera heads
+    for _ in range(100):
+        w.step()
+    still_there = np.isin(w.ids, ids)
+    assert still_there.sum() == 2 and w.stopped[still_there].all()  # they stand, and nobody flows them out
+    assert np.abs(w.pos[still_there] - start).max() < 0.1 * w.extent[1]  # a sway, not the ground's flow
+    frames, rate, _ = motion.scored_frames("mot17_like", {**overrides, "render.camera_companions": 2}, steps=150)
+    alone, _, _ = motion.scored_frames("mot17_like", overrides, steps=150)
+    assert motion.people(frames, rate)["standing"] > motion.people(alone, rate)["standing"] + 0.05
+
+
+def test_companions_need_a_camera_going_forward():
+    with pytest.raises(ConfigError, match="render.camera_companions = 2: people walk with a camera going forward"):
+        load("mot17_like", {"render.camera_companions": 2})

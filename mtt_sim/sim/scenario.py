@@ -76,6 +76,9 @@ def _check_references(sc: Scenario, where: str) -> Scenario:
         raise ConfigError(f"{where}: render.camera_forward = {sc.render.camera_forward:g} needs a ground in perspective: "
                           f"world.projection = 'standing' and world.far_scale < 1, not {sc.world.projection!r} and "
                           f"{sc.world.far_scale:g}")
+    if sc.render.camera_companions and not sc.render.camera_forward:
+        raise ConfigError(f"{where}: render.camera_companions = {sc.render.camera_companions}: people walk with a "
+                          "camera going forward; set render.camera_forward > 0 or the companions to 0")
     return _check_budget(sc, where)
 
 

@@ -38,12 +38,15 @@ class Walkers:
         return self.cfg.speed * math.exp(self.cfg.speed_jitter * rng.normal())
 
     def step(self, vel: np.ndarray, pos: np.ndarray, goal: np.ndarray, desired: np.ndarray, height: np.ndarray,
-             standing: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+             standing: np.ndarray, rng: np.random.Generator, staying: np.ndarray | None = None
+             ) -> tuple[np.ndarray, np.ndarray]:
         """One frame: the new ground velocities (px a frame) and who stands, from the current ones, positions, goals,
-        desired speeds (heights/s), heights (px) and standing flags."""
+        desired speeds (heights/s), heights (px) and standing flags; people `staying` (flags) stand throughout."""
         n = len(vel)
         u = rng.random(n)
         standing = np.where(standing, u >= self.p_go, u < self.p_stop)
+        if staying is not None:
+            standing |= staying
         to_goal = goal - pos
         direction = to_goal / np.maximum(np.hypot(*to_goal.T), 1e-9)[:, None]
         per_frame = (height * self.dt)[:, None]  # heights per second -> px per frame

@@ -60,7 +60,7 @@ class World:
                   "size": (np.float64, 2), "color": (np.uint8, 3), "cruise": np.float64, "phase": np.float64,
                   "goal": (np.float64, 2), "stopped": bool, "born": np.int64, "carrier_id": np.int64,
                   "carry_offset": (np.float64, 2), "carry_left": np.int64, "own_vel": (np.float64, 2),
-                  "desired": np.float64}
+                  "desired": np.float64, "companion": bool}
         self._cols = list(n_cols)
         for name, spec_ in n_cols.items():
             dtype, width = spec_ if isinstance(spec_, tuple) else (spec_, None)
@@ -161,7 +161,20 @@ class World:
                 pos = self._free_spot(g, (corners[:2], corners[2:]), grid)
                 size = self._spawn(gi, pos, self._initial_velocity(g), in_view=True)
                 grid.add(g.layer, pos, 0.5 * size.max())
+        self._place_companions(grid)
         self._flush()
+
+    def _place_companions(self, grid: "SpotGrid"):
+        """`render.camera_companions` people of the first group that is not carried, added at reset within a tenth
+        of the width of the middle column (where the camera heads) and in the group's rows, standing."""
+        gi = next((i for i, g in enumerate(self.sc.groups) if g.motion != "carried"), None)
+        if gi is None:
+            return
+        g, (w, h) = self.sc.groups[gi], self.extent
+        region = (np.array([0.45 * w, g.region[1] * h]), np.array([0.55 * w, g.region[3] * h]))
+        for _ in range(self.sc.render.camera_companions):
+            pos = self._free_spot(g, region, grid)
+            grid.add(g.layer, pos, 0.5 * self._spawn(gi, pos, np.zeros(2), in_view=True, companion=True).max())
 
     def _free_spot(self, g, region, grid: "SpotGrid", tries: int = 20) -> np.ndarray:
         """A point in `region` (its low and high corners) whose footprint does not overlap a placed target of the same
@@ -183,10 +196,11 @@ class World:
         return speed * np.array([math.cos(heading), math.sin(heading)])
 
     def _spawn(self, gi: int, pos: np.ndarray, vel: np.ndarray, carrier: int | None = None,
-               in_view: bool = False) -> np.ndarray:
+               in_view: bool = False, companion: bool = False) -> np.ndarray:
         """Add one target of group `gi`: a pymunk body now, a row of every state array at the next `_flush`.
         Returns its size. A walker placed `in_view` at reset stands with the walking model's stationary share (the
-        scene opens on people already there, some of them waiting); one entering walks."""
+        scene opens on people already there, some of them waiting); one entering walks; a `companion` of the camera
+        stands (`_place_companions`)."""
         g = self.sc.groups[gi]
         size = np.array(g.size) * np.exp(g.size_jitter * self.rng.normal(size=2))
         hue = self._hue0 + 0.618034 * self.next_id
@@ -196,7 +210,7 @@ class World:
         if self._walk is not None and carrier is None:  # a walker sets off toward its goal at its own speed
             desired = self._walk.desired_speed(self.rng)
             vel = (goal - pos) / max(np.hypot(*(goal - pos)), 1e-9) * desired * size[1] * self._walk.dt
-            stopped = in_view and bool(self.rng.random() < self._walk.standing_share)
+            stopped = companion or (in_view and bool(self.rng.random() < self._walk.standing_share))
             if stopped:
                 vel = np.zeros(2)
         self._pending.append(dict(
@@ -204,7 +218,7 @@ class World:
             cruise=float(np.hypot(*vel)) or g.speed, phase=phase, goal=goal, stopped=stopped, born=self.t,
             carrier_id=0 if carrier is None else int(self.ids[carrier]),
             carry_offset=np.zeros(2) if carrier is None else pos - self.pos[carrier],
-            carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel, desired=desired))
+            carry_left=_FREE if carrier is None else _FOR_GOOD, own_vel=vel, desired=desired, companion=companion))
         self.next_id += 1
         self.bodies.append(self._make_body(g, pos, vel, size, carrier))
         return size
@@ -308,9 +322,11 @@ class World:
         self._spawn_births()
 
     def _flow_forward(self, data: np.ndarray):
-        """Move every target with the ground as the camera goes forward (`mtt_sim.sim.forward`); `data` is this step's
-        read of the bodies, whose rows that are not targets keep their place."""
-        self.pos = forward.flow(self.pos, self.extent, self.sc.world.far_scale, self._forward)
+        """Move every target but the camera's companions with the ground as the camera goes forward
+        (`mtt_sim.sim.forward`); `data` is this step's read of the bodies, whose rows that are not targets keep their
+        place."""
+        flowed = forward.flow(self.pos, self.extent, self.sc.world.far_scale, self._forward)
+        self.pos = np.where(self.companion[:, None], self.pos, flowed)  # the camera's companions keep their place
         data[self._rows, :2] = self.pos[self._row_slot]
         buf = pbatch.Buffer()
         buf.set_float_buf(data[:, :2].ravel())
@@ -377,7 +393,7 @@ class World:
         model where the scene has one (`walk.model`)."""
         if self._walk is not None:
             self.vel, self.stopped = self._walk.step(self.vel, self.pos, self.goal, self.desired, self.size[:, 1],
-                                                     self.stopped, self.rng)
+                                                     self.stopped, self.rng, self.companion)
             return
         g, p = self.group, self._param
         motion = self._motion[g]

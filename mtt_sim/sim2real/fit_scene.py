@@ -253,6 +253,8 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
               f"Motion: walkers by walk.model = \"langevin\" at {info.frame_rate:g} fps; a {raw['render']['camera']} "
               "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "")
               + (f", going forward ({raw['render']['camera_forward']:g}/s: the tracklets grow and slide outward)"
-                 if raw["render"].get("camera_forward") else "") + ".",
+                 if raw["render"].get("camera_forward") else "")
+              + (f", {raw['render']['camera_companions']} of them walking with it (they hold still in the picture)"
+                 if raw["render"].get("camera_companions") else "") + ".",
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]
     return raw, real, scene, scn.to_toml(raw, header)
