@@ -66,19 +66,18 @@ def meets(real: dict, scene: dict) -> dict:
 
 def table(results: dict) -> str:
     """Per sequence: the real value, the scene's pooled value (ratio) and its seeds' range; a mark where the pooled
-    value misses the goal; the counts met pooled and by every seed alone."""
+    value misses the goal; the counts met pooled, by seed 0 alone (as issue 38 measured) and by every seed alone."""
     lines = ["| sequence | fps (scene) | camera | speed real / scene (ratio) [seeds] | deviation real / scene (ratio) "
              "[seeds] | standing real / scene [seeds] |", "|---|---:|---|---:|---:|---:|"]
     keys = ("speed", "deviation", "standing")
-    pooled, every = dict.fromkeys(keys + ("all",), 0), dict.fromkeys(keys + ("all",), 0)
+    pooled, first, every = (dict.fromkeys(keys + ("all",), 0) for _ in range(3))
     for name, r in results.items():
         real, scene, ok = r["real"], r["pooled"], meets(r["real"], r["pooled"])
         alone = {k: all(meets(real, s)[k] for s in r["scene"]) for k in keys}
-        for k in keys:
-            pooled[k] += ok[k]
-            every[k] += alone[k]
-        pooled["all"] += all(ok.values())
-        every["all"] += all(alone.values())
+        for counts, met in ((pooled, ok), (first, meets(real, r["scene"][0])), (every, alone)):
+            for k in keys:
+                counts[k] += met[k]
+            counts["all"] += all(met[k] for k in keys)
         span = lambda k, f: f"[{f.format(min(s[k] for s in r['scene']))}-{f.format(max(s[k] for s in r['scene']))}]"  # noqa: E731
         cell = lambda k, f: (f"{f.format(real[k])} / {f.format(scene[k])}"  # noqa: E731
                              + (f" (x{scene[k] / real[k]:.2f})" if k != "standing" else "")
@@ -88,7 +87,8 @@ def table(results: dict) -> str:
     n = len(results)
     count = lambda c: ", ".join(f"{k} {c[k]}/{n}" for k in keys) + f", all three {c['all']}/{n}"  # noqa: E731
     lines += ["", f"The scene over seeds {', '.join(map(str, SEEDS))} pooled (in brackets, the range of the seeds alone). "
-              f"Met pooled: {count(pooled)}. Met by every seed alone: {count(every)}."]
+              f"Met pooled: {count(pooled)}. Met by seed {SEEDS[0]} alone: {count(first)}. Met by every seed alone: "
+              f"{count(every)}."]
     return "\n".join(lines)
 
 
