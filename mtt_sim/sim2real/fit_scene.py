@@ -254,7 +254,7 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
               "camera" + (" (the tracklets' common motion)" if raw["render"]["camera"] == "walking" else "")
               + (f", going forward ({raw['render']['camera_forward']:g}/s: the tracklets grow and slide outward)"
                  if raw["render"].get("camera_forward") else "")
-              + (f", {raw['render']['camera_companions']} of them walking with it (they hold still in the picture)"
+              + (f", {raw['render']['camera_companions']} people walking along with it (they hold still in the picture)"
                  if raw["render"].get("camera_companions") else "") + ".",
               "See mtt_sim/sim2real/fit_scene.py for each estimate."]
     return raw, real, scene, scn.to_toml(raw, header)
