@@ -78,7 +78,9 @@ def test_the_cameras_companions_keep_their_place_while_the_ground_flows_out():
     w = World(load("mot17_like", {**overrides, "render.camera_companions": 2}), np.random.default_rng(3))
     assert len(w.ids) == len(plain.ids) + 2 and w.pos[:-2] == pytest.approx(plain.pos)  # added, the rest as drawn
     ids, start = w.ids[w.companion], w.pos[w.companion].copy()
-    assert np.abs(start[:, 0] / w.extent[0] - 0.5).max() <= 0.05  # beside the middle column, where the camera heads
+    assert start[:, 1] == pytest.approx(start[0, 1]) and start[:, 0].mean() == pytest.approx(w.extent[0] / 2)
+    width = w.boxes()[w.companion][:, 2]
+    assert np.diff(start[:, 0])[0] > width.mean() * 0.9  # abreast, a body width apart, about the middle column
     for _ in range(100):
         w.step()
     still_there = np.isin(w.ids, ids)

@@ -161,20 +161,23 @@ class World:
                 pos = self._free_spot(g, (corners[:2], corners[2:]), grid)
                 size = self._spawn(gi, pos, self._initial_velocity(g), in_view=True)
                 grid.add(g.layer, pos, 0.5 * size.max())
-        self._place_companions(grid)
+        self._place_companions()
         self._flush()
 
-    def _place_companions(self, grid: "SpotGrid"):
-        """`render.camera_companions` people of the first group that is not carried, added at reset within a tenth
-        of the width of the middle column (where the camera heads) and in the group's rows, standing."""
+    def _place_companions(self):
+        """`render.camera_companions` people of the first group that is not carried, added at reset abreast, a body
+        width apart in one row of the group's region and centred on the middle column (where the camera heads),
+        standing: as the pair who walk just ahead of ETH-Sunnyday's camera."""
+        count = self.sc.render.camera_companions
         gi = next((i for i, g in enumerate(self.sc.groups) if g.motion != "carried"), None)
-        if gi is None:
+        if gi is None or not count:
             return
         g, (w, h) = self.sc.groups[gi], self.extent
-        region = (np.array([0.45 * w, g.region[1] * h]), np.array([0.55 * w, g.region[3] * h]))
-        for _ in range(self.sc.render.camera_companions):
-            pos = self._free_spot(g, region, grid)
-            grid.add(g.layer, pos, 0.5 * self._spawn(gi, pos, np.zeros(2), in_view=True, companion=True).max())
+        y = self.rng.uniform(g.region[1], g.region[3]) * h
+        apart = 1.1 * g.size[0] * self.depth_scale(np.array([y]))[0]
+        for k in range(count):
+            self._spawn(gi, np.array([w / 2 + (k - (count - 1) / 2) * apart, y]), np.zeros(2), in_view=True,
+                        companion=True)
 
     def _free_spot(self, g, region, grid: "SpotGrid", tries: int = 20) -> np.ndarray:
         """A point in `region` (its low and high corners) whose footprint does not overlap a placed target of the same
