@@ -307,8 +307,9 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     if not _complete(target):
         return raw, history
 
-    def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray, float]:  # pooled over seeds, up to
-        values, jitter, people = [], [], []                                  # REFINE_WINDOWS windows
+    def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray, float]:
+        # pooled over seeds, up to REFINE_WINDOWS windows; the tracklets', the people's and their windows a frame
+        values, jitter, people = [], [], []
         for seed in range(seeds[0], seeds[0] + MAX_SEEDS):
             rows, truth = tracklets({**scene, "walk": w}, seed)
             frames = frames_of(rows, length)
