@@ -42,8 +42,8 @@ class Record:
 
 # Measured by docs/experiments/tune_sim_to_real.py --record (docs/tuning.md, "Six trackers, four routes", "The twin
 # with the boxes' jitter matched" and "The fitted scene with people who walk with the camera"): sort, bytetrack,
-# ocsort, gmphd, lmb (reid=false) and jpda, 20 trials a study, on the eight shared MOT15 sequences. The twin and the scene
-# with the detector `calibrate` fits now, leaving the sequence out; the scene as `fit-scene` fits it now
+# ocsort, gmphd, lmb (reid=false) and jpda, 20 trials a study, on the eight shared MOT15 sequences. The twin and the
+# scene with the detector `calibrate` fits now, leaving the sequence out; the scene as `fit-scene` fits it now
 # (ETH-Bahnhof, ETH-Sunnyday and KITTI-13 go forward: walking cameras).
 RECORD: dict[tuple[str, str, str], Record] = {
     ("generic", "any", "any"): Record(sequences=8, pairs=48, gaining=42, share=-0.37, losing=28),

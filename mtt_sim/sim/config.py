@@ -167,9 +167,9 @@ class RenderConfig:
                                     "depth factor s grows s times as fast); 0 = not at all (mtt_sim/sim/forward.py)",
                                     "1/s", 0.0, 5.0)
     camera_companions: int = setting(0, "going forward: people who walk with the camera (a cameraman's companions, "
-                                     "walking ahead at its pace), placed at reset abreast about the middle column, who keep "
-                                     "their place in the picture: the ground's flow does not move them, and walkers "
-                                     "among them stand", "people", 0, 20)
+                                     "walking ahead at its pace), placed at reset abreast about the middle column, "
+                                     "who keep their place in the picture: the ground's flow does not move them, and "
+                                     "walkers among them stand", "people", 0, 20)
 
 
 @dataclass(frozen=True)

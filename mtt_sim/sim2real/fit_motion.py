@@ -203,14 +203,15 @@ def fit(rows: np.ndarray, info, far_scale: float = 1.0) -> dict:
     {"world": {"frame_rate"}, "walk": the walking model's keys, "render": the camera's keys, "camera": what was
     estimated (the evidence, the per-frame shifts, whether it moves; the forward evidence)}."""
     rate, length = float(info.frame_rate), int(info.length)
-    tracks = track_rows(frames_of(rows, length))
-    ahead, pulled, along = 0.0, 0.0, 0  # forward first: its flow is no common shift, and a walker's speed does not hold it
+    frames = frames_of(rows, length)
+    tracks = track_rows(frames)
+    ahead, pulled, along = 0.0, 0.0, 0  # forward first: its flow is no common shift, nor does a walker's speed hold it
     if far_scale < 1.0:
         values = fit_forward.windows(tracks, info.width, rate)
         pulled = fit_forward.evidence(values)
         if pulled >= fit_forward.MOVING_R:
             ahead = round(fit_forward.rate(values, info.height, far_scale), 4)
-            along = fit_forward.companions(window_values(frames_of(rows, length), rate)["speed"], length, rate)
+            along = fit_forward.companions(window_values(frames, rate)["speed"], length, rate)
             tracks = fit_forward.without(tracks, (info.width, info.height), far_scale, ahead, rate)
     shift, count = common_shift(tracks, length)
     evidence = camera_evidence(tracks, length, rate)
