@@ -1,7 +1,7 @@
 """What the world that moves like the real one costs (`mtt-sim perf --sections motion`): each stage of an env step
 on `mot17_like` with its earlier walkers, with the fitted walking model and with a camera going forward (its flow
-moves everyone each step), and on `mot17_moving` with a steady pan and with the fitted walking camera, so that the
-walkers' cost is read beside the render's."""
+moves everyone each step but the people who walk with it), and on `mot17_moving` with a steady pan and with the
+fitted walking camera, so that the walkers' cost is read beside the render's."""
 
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ from mtt_sim.lab.perf import STAGES, markdown_table, stage_seconds
 CASES = (("mot17_like", "walkers before (walk.model = off)", {"walk.model": "off"}),
          ("mot17_like", "fitted walkers (as shipped)", {}),
          ("mot17_like", "fitted walkers, camera going forward", {"render.camera_forward": 0.3}),
+         ("mot17_like", "the same, 3 people walking with the camera",
+          {"render.camera_forward": 0.3, "render.camera_companions": 3}),
          ("mot17_moving", "fitted walkers, steady pan", {"render.camera": "pan", "render.pan_speed": [1.5, 0.0]}),
          ("mot17_moving", "fitted walkers, walking camera (as shipped)", {}))
 
