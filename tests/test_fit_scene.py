@@ -277,42 +277,6 @@ def test_refine_matches_who_stands_in_the_picture_of_a_camera_going_forward_with
     assert "camera_companions" not in refined["render"] and refined["walk"]["stop_rate"] > 0.1
 
 
-def walkers_and_fragments(starts: int) -> tuple[np.ndarray, list]:
-    """Eight people walking half a height a second in every one of LONG frames, and `starts` five-frame tracklets
-    that start after the first frame (a detector's fragments, or people who come and go)."""
-    from mtt_sim.sim2real import fit_motion
-
-    rows = [straight_walkers(0.5)[0]]
-    rows += [np.array([(f, 100 + k, 300.0, 20.0, 0.4 * TALL, TALL) for f in range(1 + k % 70, 6 + k % 70)])
-             for k in range(starts)]
-    rows = np.concatenate(rows)
-    return rows, fit_motion.frames_of(rows, LONG)
-
-
-def test_refine_sets_the_births_at_which_the_scenes_tracklets_start_as_the_sequences_do():
-    """The sequence's tracklets start 0.05 times a frame after the first; the fit took that for the births, but the
-    scene's tracklets start twice as often as its people are born (its detector breaks each track in two): the
-    refinement halves the births, to 0.025, at which the scene's tracklets start as the sequence's."""
-    from mtt_sim.sim2real import fit_motion
-
-    seq_rows, _ = walkers_and_fragments(round(0.05 * (LONG - 1)))
-    starts = fit_motion.tracklet_starts(seq_rows, LONG)
-    assert starts == pytest.approx(4 / 79)
-
-    def scene(raw, seed):
-        return walkers_and_fragments(round(2 * raw["doors"][0]["birth_rate"] * (LONG - 1)))
-
-    raw = {"walk": {"model": "langevin", "speed": 0.5, "stop_rate": 0.1, "go_rate": 0.5, "noise": 0.1, "relax": 0.5},
-           "sensor": {"preset": "ideal"}, "groups": [{"name": "people", "birth_rate": 0.0}],
-           "doors": [{"role": "entry", "birth_rate": starts}, {"role": "exit"}]}
-    target = fit_motion.tracklet_motion(seq_rows, LONG, RATE)
-    refined, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,), starts=starts)
-    assert refined["doors"][0]["birth_rate"] == pytest.approx(starts / 2, abs=2e-3)
-    assert refined["groups"][0]["birth_rate"] == 0.0 and "birth_rate" not in refined["doors"][1]
-    unchanged, _ = fit_motion.refine(raw, target, scene, LONG, RATE, seeds=(0,))  # no starts given: births kept
-    assert unchanged["doors"] == raw["doors"]
-
-
 def test_refine_sets_the_noise_that_brings_the_scenes_deviation_up_to_the_sequences(monkeypatch):
     """A fake scene whose tracklets deviate by sqrt(floor^2 + (k noise)^2) (the detector's deviation and the walkers'
     adding in squares): the refinement solves for the noise at which they deviate as the sequence's do."""

@@ -64,7 +64,6 @@ LIMITS = {"noise": (0.005, 10.0), "stop_rate": (0.01, 100.0),
 REACH = {"noise": 10.0, "stop_rate": 10.0, "speed": 3.0}  # the refinement moves each at most this far from the fit
 NOISE_KEYS = fit_jitter.KEYS  # the detector's frame-to-frame noise, scaled to the jitter as calibrate matches it
 NOISE_REACH = 4.0     # ... at most this far either way
-BIRTHS_REACH = 5.0    # the refinement moves the births at most this far either way in one step
 SIDEWAYS = math.cos(math.radians(45))  # a heading whose cosine is beyond this walks across (left or right)
 WALK_KEYS = ("model", "speed", "speed_jitter", "relax", "noise", "stand_noise", "stop_rate", "go_rate")
 
@@ -267,10 +266,9 @@ def _measured(values: dict, jitter: np.ndarray) -> np.ndarray:
 
 
 def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: float,
-           seeds=(100, 101), starts: float | None = None) -> tuple[dict, list]:
+           seeds=(100, 101)) -> tuple[dict, list]:
     """The scene `raw` (with its detector) with its detector's box noise and its walkers' noise, stop rate and desired
-    speed set so that the scene shows the sequence's tracklets' motion (`target`, from `tracklet_motion`), and, given
-    the sequence's tracklet `starts` a frame (`tracklet_starts`), its births so that its tracklets start as often.
+    speed set so that the scene shows the sequence's tracklets' motion (`target`, from `tracklet_motion`).
     `tracklets(raw, seed)` runs the scene once: its detections linked as the sequence's were, and its people (each
     frame's scored ids and boxes); each run pools `seeds` and more, up to MAX_SEEDS, until REFINE_WINDOWS windows.
 
@@ -293,11 +291,7 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
        matched by the camera's companions instead (`fit_forward.companions`; added or taken away by the share missing
        times the people's windows a frame): there a person standing on the ground flows out of the picture, and the
        stop rate barely moved the share (ETH-Sunnyday's scene stood 0.15 of its windows at a stop rate of 0.22/s and
-       0.13 at 2.8/s), so the walkers keep the stop rate fitted with the flow taken out. Given `starts`, the births
-       are scaled by the sequence's tracklet starts a frame over the scene's: the fit took the sequence's starts for
-       its births, yet a detector's misses break one person's track into several, in the sequence and in the scene
-       alike (on the eight shared sequences the tracklets start 0.7-4.8 times as often as the ground truth's people
-       enter; the scenes fitted without this step held up to 3.1 times the real people a frame, with it 0.65-1.33);
+       0.13 at 2.8/s), so the walkers keep the stop rate fitted with the flow taken out;
     4. and 5. with that stop rate and speed, and the noise as fitted and a tenth of it: the deviation that the
        detector, SORT and the camera make by themselves (the floor) and how it grows with the walkers' noise. Their
        own deviation adds to the floor in squares; the noise is the one that brings the floor up to the sequence's.
@@ -307,39 +301,33 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
        deviation (fit_walkers then kept the shipped relaxation and noise), the noise is kept and runs 4 to 6 skipped;
     6. with that noise, the stop rate and speed scaled once more as in 2.: a walker's noise moves how often it seems to
        stand (fast noise slows walkers below STANDING now and then), and without this step PETS09-S2L1's scene stood
-       in 0.04 of its windows against the 0.09 it had matched. The births are not scaled again here: the noise was
-       set for the crowd they give.
+       in 0.04 of its windows against the 0.09 it had matched.
     Returns the scene and the runs' keys and measurements (tracklets', then people's)."""
     walk = dict(raw["walk"])
     history: list[tuple[dict, np.ndarray, np.ndarray]] = []
     if not _complete(target):
         return raw, history
 
-    def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray, float, float]:
-        # pooled over seeds, up to REFINE_WINDOWS windows; the tracklets', the people's, their windows a frame and the
-        # tracklets' starts a frame
-        values, jitter, people, began = [], [], [], []
+    def run(scene: dict, w: dict) -> tuple[np.ndarray, np.ndarray, float]:
+        # pooled over seeds, up to REFINE_WINDOWS windows; the tracklets', the people's and their windows a frame
+        values, jitter, people = [], [], []
         for seed in range(seeds[0], seeds[0] + MAX_SEEDS):
             rows, truth = tracklets({**scene, "walk": w}, seed)
             frames = frames_of(rows, length)
             values.append(window_values(frames, frame_rate))
             jitter.append(jitters(frames))
             people.append(window_values(truth, frame_rate))
-            began.append(tracklet_starts(rows, length))
             if seed - seeds[0] + 1 >= len(seeds) and sum(len(v["speed"]) for v in values) >= REFINE_WINDOWS:
                 break
         pooled = lambda parts: {k: np.concatenate([v[k] for v in parts]) for k in ("speed", "deviation")}  # noqa: E731
         got = (_measured(pooled(values), np.concatenate(jitter)), _measured(pooled(people), np.zeros(0)))
         history.append((dict(w), *got))
-        return (*got, sum(len(v["speed"]) for v in people) / (len(people) * length), float(np.mean(began)))
+        return (*got, sum(len(v["speed"]) for v in people) / (len(people) * length))  # the people's windows a frame
 
-    def people_matched(scene: dict, w: dict, births: bool = True) -> tuple[dict, dict] | None:
-        # the standing share and the walking speed, and the births where asked
-        first, people, windows, began = run(scene, w)
+    def people_matched(scene: dict, w: dict) -> tuple[dict, dict] | None:  # the standing share and walking speed
+        first, people, windows = run(scene, w)
         if not _complete(first):
             return None
-        if births and starts is not None and began > 0:
-            scene = _with_births(scene, starts / began)
         factor = {"speed": target[4] / people[4]}
         if scene.get("render", {}).get("camera_forward"):  # who stands in the picture walks with the camera
             scene = _with_companions(scene, (target[2] - people[2]) * windows)
@@ -368,26 +356,8 @@ def refine(raw: dict, target: np.ndarray, tracklets, length: int, frame_rate: fl
     else:  # the floor is at or above the sequence's, or no response was seen: the noise deflated in proportion
         noise = walk["noise"] * target[1] / max(first[1], 1e-6)
     final = {**low, "noise": round(float(np.clip(noise, low["noise"], walk["noise"] * REACH["noise"])), 4)}
-    raw, final = people_matched(raw, final, births=False) or (raw, final)
+    raw, final = people_matched(raw, final) or (raw, final)
     return {**raw, "walk": final}, history
-
-
-def tracklet_starts(rows: np.ndarray, length: int) -> float:
-    """Tracklets (rows frame from 0, id, ...) that start after the first frame, a frame."""
-    if not len(rows):
-        return 0.0
-    r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]
-    first = np.unique(r[:, 1], return_index=True)[1]
-    return float(np.sum(r[first, 0] > 0)) / max(length - 1, 1)
-
-
-def _with_births(raw: dict, factor: float) -> dict:
-    """The scene `raw` with every birth rate (its groups' and its doors') times `factor`, within BIRTHS_REACH either
-    way."""
-    factor = float(np.clip(factor, 1 / BIRTHS_REACH, BIRTHS_REACH))
-    scaled = lambda items: [{**d, "birth_rate": round(d["birth_rate"] * factor, 4)} if "birth_rate" in d else d
-                            for d in items]  # noqa: E731
-    return {**raw, **{k: scaled(raw[k]) for k in ("groups", "doors") if k in raw}}
 
 
 def _with_companions(raw: dict, more: float) -> dict:

@@ -20,8 +20,7 @@ to what they show (ground truth is never read, so gt/ may be missing or anything
   tracklets with the camera's common motion taken out, then refined by running the scene with its detector and
   linking its detections as the sequence's were, `fit_scene(refine=True)`), entering and leaving by doors at the
   left and right borders in the band of their feet (births: tracklet starts per frame after the first frame, shared
-  by the entry doors, then scaled by the refinement until the scene's tracklets start as often; the group's own
-  birth_rate is 0), and its camera is the walking camera model fitted to the
+  by the entry doors; the group's own birth_rate is 0), and its camera is the walking camera model fitted to the
   common motion where the tracklets show one, else the still camera; the group's cv keys (speed, heading) stay, for
   walk.model = "off";
 - the detector: the [sensor] table of a sensor file (`mtt-sim calibrate` on other, labelled sequences), its box
@@ -130,7 +129,7 @@ def statistics(rows: np.ndarray, length: int, height: int) -> dict:
     a, b = _height_line(rows)
     near = a + b * height
     speed = np.linalg.norm(c1 - c0, axis=1) / np.maximum(end - start, 1)
-    return {"people": len(rows) / length, "births": fit_motion.tracklet_starts(rows, length),
+    return {"people": len(rows) / length, "births": float(np.sum(start > 0)) / max(length - 1, 1),
             "height": float(np.median(rows[:, 5])),
             "far_near": float(np.clip(a / near, 0.05, 1.0)) if b > 0 and near > 0 else 1.0,
             "speed": float(np.median(speed))}
@@ -243,8 +242,7 @@ def fit_scene(folder, sensor=None, seeds=(0, 1), refine: bool = True) -> tuple[d
     scn.from_mapping(raw, f"scene fitted to {folder}")
     if refine:
         raw = fit_motion.refine(raw, fit_motion.tracklet_motion(rows, info.length, info.frame_rate), _scene_tracklets,
-                                info.length, info.frame_rate,
-                                starts=fit_motion.tracklet_starts(rows, info.length))[0]
+                                info.length, info.frame_rate)[0]
     real = statistics(rows, info.length, info.height)
     scene = scene_statistics(raw, seeds) if seeds else {}
     header = [f"mtt-sim fit-scene: a scene fitted to the detections of {Path(folder).name} alone",
