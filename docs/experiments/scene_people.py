@@ -8,7 +8,8 @@ by one function, frame by frame:
 - p95 height: the 95th percentile of their box heights, px;
 - end inside: of the people whose last frame comes before the sequence's, the share whose last box lies inside the
   picture (more than 5 px from every border): people lost to occlusion or no longer annotated, not walking out;
-- last height: the median height of those last boxes, px.
+- last height: the median height of those last boxes, px;
+- ended: how many people ended so (the scene's: a mean over its seeds).
 
     python docs/experiments/scene_people.py ../shared/data/mot15 work/rows --seeds 2
 """
@@ -62,8 +63,8 @@ def measure(frames: list, size: tuple[int, int]) -> dict:
 
 
 def pooled(runs: list[dict]) -> dict:
-    """Seeds' statistics averaged (the people who ended, summed)."""
-    return {k: (sum if k == "ended" else np.mean)([r[k] for r in runs]) for k in runs[0]}
+    """Seeds' statistics averaged."""
+    return {k: float(np.mean([r[k] for r in runs])) for k in runs[0]}
 
 
 def main() -> None:
@@ -83,7 +84,7 @@ def main() -> None:
                       for s in range(args.seeds)])
         print(f"| {folder.name} | {real['hidden']:.2f} / {sim['hidden']:.2f} | {real['p95']:.0f} / {sim['p95']:.0f} | "
               f"{real['inside']:.2f} / {sim['inside']:.2f} | {real['last']:.0f} / {sim['last']:.0f} | "
-              f"{real['ended']} / {sim['ended']} |", flush=True)
+              f"{real['ended']} / {sim['ended']:.1f} |", flush=True)
 
 
 if __name__ == "__main__":
