@@ -48,12 +48,13 @@ def twin(folder) -> TrackingEnv:
 
 def measure(frames: list, size: tuple[int, int]) -> dict:
     """The statistics of the module's docstring over `frames`."""
+    ids = np.concatenate([i for i, _, _ in frames])
+    boxes = np.concatenate([b for _, b, _ in frames]).reshape(-1, 4)
     visibility = np.concatenate([v for _, _, v in frames])
-    heights = np.concatenate([b[:, 3] for _, b, _ in frames])
-    last = {}
-    for k, (ids, boxes, _) in enumerate(frames):
-        last.update({int(i): (k, b) for i, b in zip(ids, boxes)})
-    ends = np.array([b for k, b in last.values() if k < len(frames) - 1]).reshape(-1, 4)
+    frame = np.repeat(np.arange(len(frames)), [len(i) for i, _, _ in frames])
+    last = len(ids) - 1 - np.unique(ids[::-1], return_index=True)[1]  # each person's last row
+    ends = boxes[last[frame[last] < len(frames) - 1]]
+    heights = boxes[:, 3]
     w, h = size
     inside = ((ends[:, 0] > BORDER) & (ends[:, 1] > BORDER) & (ends[:, 0] + ends[:, 2] < w - BORDER)
               & (ends[:, 1] + ends[:, 3] < h - BORDER))
