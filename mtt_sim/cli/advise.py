@@ -1,6 +1,6 @@
 """`mtt-sim advise`: the label-free route in one command. For a camera with detections and no labels: fit its scene,
-tune each candidate tracker on it, and print them ranked, each with its tuned spec (ready for --tracker), its spread
-over the scene's seeds, and what the route is worth on real cameras of this kind."""
+tune each candidate tracker on it, and print them ranked, each with its tuned spec (ready for --tracker), its score and
+spread over fresh seeds of the scene, and what the route is worth on real cameras of this kind."""
 
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def run(args) -> int:
     out = output_file(args.out, force, "--out", (".md",))
     scene_file = output_file(args.scene, args.force, "--scene", (".toml",))
     check_sensor(args.sensor)
-    work = estimate("advise", [(len(args.trackers), "trackers"), (args.trials + 1, "runs"), (len(args.seeds), "seeds")],
+    work = estimate("advise", [(len(args.trackers), "trackers"), (args.trials + 2, "runs"), (len(args.seeds), "seeds")],
                     [args.folder], {"sensor.model": "synthetic"})
     if dry_run(args, work + ", after the scene's fit"):
         return 0
@@ -55,7 +55,7 @@ def run(args) -> int:
 
     definition = {"folder": str(Path(args.folder).resolve()), "sensor": Path(args.sensor).read_text(),
                   "trackers": args.trackers, "metric": args.metric, "trials": args.trials, "seeds": args.seeds,
-                  "seed": args.seed}
+                  "seed": args.seed, "scored on": "fresh seeds"}
     journal = resuming.journal(out, definition, args.resume, "candidates") if out else None
     say = (lambda line: print(line, file=sys.stderr, flush=True))
     path = scene_file or Path(out or ".").with_name(f".advise_{Path(args.folder).name}_scene.toml")

@@ -37,6 +37,9 @@ def add(subparsers) -> None:
     p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("1"),
                    help="episode seeds per source: a count (3: seeds 0..2), a list or a range (default 1)")
     p.add_argument("--seed", type=integer(0), default=0, help="the sampler's seed: one seed, one study (default 0)")
+    p.add_argument("--confirm", type=integer(0), default=0, metavar="N",
+                   help="then run the best spec and the defaults on N fresh seeds of the simulated sources, for a "
+                        "score the study's own seeds did not choose (default 0: none)")
     p.add_argument("--workers", type=integer(1), default=1, help="processes running a trial's episodes (default 1)")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
                    help="local processes, or Ray tasks for a trial's episodes (the [ray] extra; --address for a cluster)")
@@ -71,6 +74,8 @@ def run(args) -> int:
         raise UsageError("--address", f"{args.address!r}: a Ray cluster's address goes with --backend ray")
     trials = [(args.trials, "trials"), (len(args.on), "sources"), (len(args.seeds), "seeds")]
     work = estimate("tune", trials, args.on, overrides)
+    if args.confirm:
+        _fresh(args.on, overrides)
     if dry_run(args, work):
         return 0
     announce(work)
@@ -81,7 +86,7 @@ def run(args) -> int:
         result, study = tune.tune(args.spec, args.on, args.metric, args.trials, args.seeds, overrides, args.seed,
                                   args.workers, args.storage, args.study_name, args.time_budget,
                                   progress=not args.json, backend=args.backend, address=args.address,
-                                  say=lambda line: print(line, file=sys.stderr))
+                                  confirm_seeds=args.confirm, say=lambda line: print(line, file=sys.stderr))
     except tune.Interrupted as stop:  # Ctrl-C or SIGTERM: the trial in flight marked interrupted, the best so far
         if stop.result is None:
             print("mtt-sim tune: interrupted before any trial finished" + _resume(args, stop.study.study_name),
@@ -120,6 +125,16 @@ def _caution(spec: str, sources: list[str], overrides: dict) -> None:
     taken = {routes.route_of(source, overrides) for source in sources} - {None}
     for line in sorted(filter(None, {routes.caution(*route, tracker) for route in taken})):
         print(f"mtt-sim tune: warning: {line}", file=sys.stderr)
+
+
+def _fresh(sources: list[str], overrides: dict) -> None:
+    """Where --confirm has nothing to run again: every source a sequence scored on its own detections."""
+    from mtt_sim.lab.confirm import simulated
+
+    if not simulated(sources, overrides):
+        raise UsageError("--confirm", "every source is a recorded sequence on its own detections, the same episode "
+                                      "whatever the seed: there is nothing to confirm (fresh seeds need a scenario, "
+                                      "a scenario file or a twin, --config sensor.model=synthetic)")
 
 
 def _resume(args, study: str) -> str:

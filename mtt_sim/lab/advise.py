@@ -1,6 +1,8 @@
 """The label-free route in one step (`mtt-sim advise`): for a camera with detections and no labels, fit its scene
-(`fit_scene`), tune each candidate tracker on it (`tune`) and rank them by the tuned score, with the simulator's
-confidence: each tuned spec's spread over the scene's seeds and how often the first beats the others seed by seed.
+(`fit_scene`), tune each candidate tracker on it (`tune`) and rank them by the tuned spec's score on as many fresh
+seeds of the scene (`confirm`: a study's best is flattered by its own seeds, and more so the noisier a tracker's
+trials), with the simulator's confidence: each tuned spec's spread over those seeds and how often the first beats the
+others seed by seed.
 
 What the ranking is worth on real video is measured, not assumed: `routes.RECORD` holds the label-free route's figures
 on the shared MOT15 sequences (docs/tuning.md), per kind of camera, and `warnings` adds the line a user of a camera of
@@ -21,8 +23,8 @@ CANDIDATES = ("sort", "bytetrack", "ocsort", "iou", "gmphd")  # fast and sound o
 
 @dataclass(frozen=True)
 class Choice:
-    """One candidate on the fitted scene: its tuned spec (for --tracker), its score a seed (the scene's seeds), their
-    mean and standard deviation, and the defaults' mean on the same seeds."""
+    """One candidate on the fitted scene: its tuned spec (for --tracker), its score a seed (fresh seeds of the scene,
+    none of them tuned on), their mean and standard deviation, and the defaults' mean on the same seeds."""
 
     tracker: str
     spec: str
@@ -43,10 +45,9 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
            finished: Callable[[str, Choice], None] | None = None,
            say: Callable[[str], None] | None = None) -> list[Choice]:
     """Each candidate spec tuned on the scene file `scene` (`trials` trials of `seeds`, TPE seeded by `seed`), then
-    run alone on each seed; best first. `done(spec)` gives a candidate finished earlier (a resumed run), `finished`
-    is told each one as it finishes, `say` the progress."""
+    run with its defaults on as many fresh seeds; best first on those. `done(spec)` gives a candidate finished earlier
+    (a resumed run), `finished` is told each one as it finishes, `say` the progress."""
     from mtt_sim.lab import tune
-    from mtt_sim.lab.experiment import run_episode
     from mtt_sim.trackers import TrackerSpec
 
     say = say or (lambda line: None)
@@ -55,9 +56,9 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
         choice = done(spec) if done else None
         if choice is None:
             say(f"advise: tuning {spec} ({k} of {len(candidates)}), {trials} trials x {len(seeds)} seeds")
-            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed)
-            per_seed = tuple(tune.score(run_episode(scene, result.spec, s), metric) for s in seeds)
-            choice = Choice(TrackerSpec.of(spec).registered, result.spec, per_seed, float(result.default_value))
+            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed, confirm_seeds=len(seeds))
+            fresh = result.confirmed
+            choice = Choice(TrackerSpec.of(spec).registered, result.spec, fresh.per_seed, fresh.default_value[0])
             if finished:
                 finished(spec, choice)
         choices.append(choice)
@@ -65,14 +66,14 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
 
 
 def wins(first: Choice, other: Choice) -> int:
-    """On how many of the scene's seeds `first` scores above `other` (paired: the same episodes)."""
+    """On how many of the fresh seeds `first` scores above `other` (paired: the same episodes)."""
     return sum(a > b for a, b in zip(first.per_seed, other.per_seed))
 
 
 def table(choices: Sequence[Choice], metric: str) -> str:
-    """The ranking as Markdown: rank, tracker, the tuned score (mean, sd over seeds), the defaults', the seeds on
+    """The ranking as Markdown: rank, tracker, the tuned score (mean, sd over fresh seeds), the defaults', the seeds on
     which the first beats it, and the tuned spec."""
-    lines = [f"| rank | tracker | {metric} tuned (mean ± sd over seeds) | {metric} defaults | first wins on | "
+    lines = [f"| rank | tracker | {metric} tuned (mean ± sd over fresh seeds) | {metric} defaults | first wins on | "
              "tuned spec |", "|---:|---|---:|---:|---:|---|"]
     for rank, c in enumerate(choices, 1):
         beaten = "-" if rank == 1 else f"{wins(choices[0], c)} of {len(c.per_seed)} seeds"

@@ -112,6 +112,14 @@ def run_episode(scenario: str, tracker: str = "sort", seed: int = 0, config: Map
     return run_episodes(scenario, [tracker], seed, config, video, steps, progress, results=results)[0]
 
 
+def score(record: dict, metric: str) -> float:
+    """An episode record's `metric`; an unscored one is an error, not a zero."""
+    value = (record["metrics"] or {}).get(metric)
+    if value is None:
+        raise RuntimeError(f"{record['scenario']}: no {metric} (an unscored source, or nothing to count)")
+    return float(value)
+
+
 def failed_record(task: tuple, message: str) -> dict:
     """The record of grid task (scenario, tracker, seed, config, results file) whose episode failed with `message`."""
     scenario, tracker, seed, config, _ = task

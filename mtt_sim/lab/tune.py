@@ -27,7 +27,8 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
-from mtt_sim.lab.experiment import episode_pool, run_tasks
+from mtt_sim.lab.confirm import Confirmation, confirm, fresh_seeds
+from mtt_sim.lab.experiment import episode_pool, run_tasks, score
 from mtt_sim.lab.study import (counted, default_study_name, definition, mark_interrupted, open_storage, open_study,
                                state)
 from mtt_sim.metrics.goals import Goal, goals
@@ -54,12 +55,14 @@ class Result:
     wanted: int = 0
     kept: int = 0
     interrupted: bool = False
+    confirmed: Confirmation | None = None
 
     def as_dict(self) -> dict:
         return {"spec": self.spec, "value": self.value, "default_value": self.default_value,
                 "trials": self.finished, "trials_wanted": self.wanted, "interrupted": self.interrupted,
                 "study": self.study, "states": self.trials, "params": self.params,
-                "metric": ",".join(g.text for g in self.goals), "front": self.front}
+                "metric": ",".join(g.text for g in self.goals), "front": self.front,
+                "confirmed": self.confirmed.as_dict() if self.confirmed else None}
 
     def toml(self) -> str:
         """The result as TOML: the spec, the study, the trials finished (of those wanted, and whether interrupted),
@@ -67,7 +70,8 @@ class Result:
         head = {k: v for k, v in self.as_dict().items()
                 if k in ("spec", "metric", "study", "trials", "trials_wanted", "interrupted")}
         scores = {k: v for k, v in (("value", self.value), ("default_value", self.default_value)) if v is not None}
-        return to_toml({**head, **scores, "params": self.params})
+        confirmed = {"confirmed": self.confirmed.as_dict()} if self.confirmed else {}
+        return to_toml({**head, **scores, "params": self.params, **confirmed})
 
 
 class NoTrialFinished(RuntimeError):
@@ -87,13 +91,15 @@ class Interrupted(KeyboardInterrupt):
 def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 50, seeds: Sequence[int] = (0,),
          config: Mapping | None = None, seed: int = 0, workers: int = 1, storage: str | None = None,
          study_name: str | None = None, time_budget: float | None = None, progress: bool = False,
-         backend: str = "local", address: str | None = None,
+         backend: str = "local", address: str | None = None, confirm_seeds: int = 0,
          say: Callable[[str], None] | None = None) -> tuple[Result, object]:
     """Tune `spec` on `sources` (scenario keys, TOML files, sequence folders) over `seeds` until the study has
     `trials` finished trials (complete, pruned, or failed by their own error; fewer within `time_budget` seconds),
     TPE seeded by `seed`. `storage` (an Optuna URL such as sqlite:///study.db) keeps the study, which a later call
     resumes: by default it is named after the definition, and a `study_name` whose stored definition differs is
-    refused with a ValueError. `say` gets the lines worth telling a user (a resumed study's counts, a failed trial).
+    refused with a ValueError. With `confirm_seeds`, the best spec and the defaults then run on that many fresh seeds
+    of the simulated sources (`confirm`: the result's `confirmed`). `say` gets the lines worth telling a user (a
+    resumed study's counts, a failed trial).
     Returns the result and the Optuna study; on Ctrl-C raises `Interrupted` with the best so far."""
     import optuna
 
@@ -183,6 +189,15 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
             _note(result, study, trials, kept)
             raise Interrupted(result, study)
         result = _result(study, name, fixed, wanted)
+    if confirm_seeds:  # after the study, so Ctrl-C stops it at once; the study itself is finished and stored
+        defaults = spec_of(name, {**fixed, **{k: spec.values[k] for k in space}})
+        try:
+            result.confirmed = confirm(result.spec, defaults, sources, wanted, fresh_seeds(seeds, confirm_seeds),
+                                       config, workers, backend, address)
+        except KeyboardInterrupt:
+            result.interrupted = True
+            _note(result, study, trials, kept)
+            raise Interrupted(result, study) from None
     _note(result, study, trials, kept)
     return result, study
 
@@ -248,14 +263,6 @@ def _note(result: Result | None, study, trials: int, kept: int) -> None:
                                                                      trials, kept)
 
 
-def score(record: dict, metric: str) -> float:
-    """An episode record's `metric`; an unscored one is an error, not a zero."""
-    value = (record["metrics"] or {}).get(metric)
-    if value is None:
-        raise RuntimeError(f"{record['scenario']}: no {metric} (an unscored source, or nothing to count)")
-    return float(value)
-
-
 def _mean(values: list[list[float]], k: int) -> float:
     return math.fsum(v[k] for v in values) / len(values)
 
@@ -308,6 +315,8 @@ def report(result: Result, study, count: int = 5) -> str:
              f"best{' so far' if result.interrupted else ''}: {result.spec}",
              f"{metric}: {result.value} (defaults: {result.default_value})",
              "trials: " + ", ".join(f"{n} {state}" for state, n in result.trials.items())]
+    if result.confirmed:
+        lines.append(result.confirmed.line())
     if result.interrupted:
         lines.append(f"interrupted: {result.finished} of {result.wanted} trials finished")
     return "\n".join(table + lines)
