@@ -40,7 +40,8 @@ def test_a_study_confirmed_scores_its_best_and_the_defaults_on_seeds_it_never_ra
 
 def test_the_verdict_follows_each_metrics_direction():
     def made(metric, tuned, default, spec="sort:max_age=3"):
-        return Confirmation(spec, "sort", (2,), ("crossing",), tuple(goals(metric)), (tuned,), (default,), (tuned,), (default,))
+        return Confirmation(spec, "sort", (2,), ("crossing",), tuple(goals(metric)), (tuned,), (default,), (tuned,),
+                            (default,))
 
     assert made("HOTA", 0.6, 0.5).holds and not made("HOTA", 0.5, 0.5).holds and not made("HOTA", 0.4, 0.5).holds
     assert made("IDSW", 3, 5).holds and not made("IDSW", 5, 3).holds      # fewer switches is better

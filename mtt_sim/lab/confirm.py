@@ -42,7 +42,8 @@ class Confirmation:
         return a > b if self.goals[0].maximize else a < b
 
     def as_dict(self) -> dict:
-        return {"spec": self.spec, "defaults": self.defaults, "seeds": list(self.seeds), "sources": list(self.sources), "value": list(self.value),
+        return {"spec": self.spec, "defaults": self.defaults, "seeds": list(self.seeds), "sources": list(self.sources),
+                "value": list(self.value),
                 "default_value": list(self.default_value), "holds": self.holds}
 
     def line(self) -> str:
@@ -93,8 +94,8 @@ def confirm(spec: str, defaults: str, sources: Sequence[str], goals: Sequence[Go
         first = [score(r, goals[0].metric) for r in part]  # source-major: seed k of every source
         return tuple(math.fsum(first[k::len(seeds)]) / len(sources) for k in range(len(seeds)))
 
-    return Confirmation(spec, defaults, tuple(seeds), tuple(sources), tuple(goals), means(tuned), means(base), per_seed(tuned),
-                        per_seed(base))
+    return Confirmation(spec, defaults, tuple(seeds), tuple(sources), tuple(goals), means(tuned), means(base),
+                        per_seed(tuned), per_seed(base))
 
 
 def _seeds(seeds: Sequence[int]) -> str:
