@@ -80,6 +80,14 @@ def test_two_trackers_the_seeds_cannot_tell_apart_are_said_to_be():
     assert not any("cannot tell" in w for w in advise.warnings([a, c], "still"))
 
 
+def test_a_first_choice_no_better_than_its_defaults_on_the_fresh_seeds_is_said_to_be():
+    c = advise.Choice("iou", "iou", (0.1, 0.1), 0.1)
+    a = advise.Choice("sort", "sort:max_age=9", (0.50, 0.40), 0.46)
+    assert any("below its defaults" in w and "(45.0 against 46.0)" in w for w in advise.warnings([a, c], "still"))
+    b = advise.Choice("sort", "sort", (0.50, 0.40), 0.45)  # the defaults themselves
+    assert not any("below its defaults" in w for w in advise.warnings([b, c], "still"))
+
+
 def test_the_routes_record_on_real_cameras_of_the_kind_is_told(monkeypatch):
     a, c = advise.Choice("sort", "sort", (0.50, 0.40), 0.45), advise.Choice("iou", "iou", (0.10, 0.11), 0.10)
     monkeypatch.setattr(routes, "RECORD", {})

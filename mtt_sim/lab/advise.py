@@ -84,14 +84,19 @@ def table(choices: Sequence[Choice], metric: str) -> str:
 
 def warnings(choices: Sequence[Choice], camera: str) -> list[str]:
     """What a user should know before trusting the ranking: a first choice within the seeds' spread of the second
-    (the simulator cannot tell them apart), and the route's record for the first choice's tracker on real cameras of
-    this kind (`camera`, as `routes.camera_kind` reads it; `routes.RECORD`)."""
+    (the simulator cannot tell them apart), a first choice whose tuned spec scores below its defaults on the fresh
+    seeds, and the route's record for the first choice's tracker on real cameras of this kind (`camera`, as
+    `routes.camera_kind` reads it; `routes.RECORD`)."""
     out = []
     if len(choices) > 1:
         a, b = choices[0], choices[1]
         if a.score - b.score <= max(a.spread, b.spread) or wins(a, b) < len(a.per_seed):
             out.append(f"{a.tracker} and {b.tracker} are within the seeds' spread on this scene ({wins(a, b)} of "
                        f"{len(a.per_seed)} seeds to {a.tracker}): the scene cannot tell them apart; try both")
+    if choices and choices[0].score < choices[0].default:
+        first = choices[0]
+        out.append(f"{first.tracker}'s tuned spec scores below its defaults on the fresh seeds ({100 * first.score:.1f} "
+                   f"against {100 * first.default:.1f}): its study's gain did not hold; its defaults may do better")
     line = routes.caution("scene", camera, choices[0].tracker if choices else routes.ANY)
     if line:
         out.append(line)
