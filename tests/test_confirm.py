@@ -66,6 +66,9 @@ def test_the_command_prints_the_fresh_scores_and_refuses_what_it_cannot_confirm(
     assert cli.main(["tune", "sort", "--on", "crossing", "--trials", "2", "--confirm", "1",
                      "--config", "env.max_steps=30"]) == 0
     assert "on 1 fresh seed (1): HOTA" in capsys.readouterr().out
+    assert cli.main(["tune", "sort", "--on", "crossing,clutter_storm", "--seeds", "2", "--confirm", "3",
+                     "--dry-run"]) == 0
+    assert capsys.readouterr().out.strip().endswith("then the best and the defaults on 3 fresh seeds (12 episodes)")
     folder = write_sequence(tmp_path / "seq", det=[(f, 10, 10, 20, 40, 0.9) for f in range(1, 6)],
                             gt=[(f, 1, 10, 10, 20, 40, 1, 1, 1.0) for f in range(1, 6)])
     assert cli.main(["tune", "sort", "--on", str(folder), "--confirm", "2"]) == 2

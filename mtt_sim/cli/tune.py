@@ -75,7 +75,8 @@ def run(args) -> int:
     trials = [(args.trials, "trials"), (len(args.on), "sources"), (len(args.seeds), "seeds")]
     work = estimate("tune", trials, args.on, overrides)
     if args.confirm:
-        _fresh(args.on, overrides)
+        fresh = _fresh(args.on, overrides)
+        work += f", then the best and the defaults on {args.confirm} fresh seeds ({2 * args.confirm * fresh} episodes)"
     if dry_run(args, work):
         return 0
     announce(work)
@@ -127,14 +128,17 @@ def _caution(spec: str, sources: list[str], overrides: dict) -> None:
         print(f"mtt-sim tune: warning: {line}", file=sys.stderr)
 
 
-def _fresh(sources: list[str], overrides: dict) -> None:
-    """Where --confirm has nothing to run again: every source a sequence scored on its own detections."""
+def _fresh(sources: list[str], overrides: dict) -> int:
+    """How many sources --confirm runs again; none (every source a sequence scored on its own detections) is an
+    error."""
     from mtt_sim.lab.confirm import simulated
 
-    if not simulated(sources, overrides):
+    count = len(simulated(sources, overrides))
+    if not count:
         raise UsageError("--confirm", "every source is a recorded sequence on its own detections, the same episode "
                                       "whatever the seed: there is nothing to confirm (fresh seeds need a scenario, "
                                       "a scenario file or a twin, --config sensor.model=synthetic)")
+    return count
 
 
 def _resume(args, study: str) -> str:
