@@ -125,9 +125,9 @@ def confirm_rows(args, out: Path) -> None:
         folder = Path(args.data) / row["sequence"]
         source, config = _source(row["route"], folder, work)
         seeds = fresh_seeds(range(FRESH), args.confirm)
-        got = confirm(row["spec"], row["tracker"], [source], goals(args.metric), seeds, config, args.workers)
+        got = confirm([row["spec"]], row["tracker"], [source], goals(args.metric), seeds, config, args.workers)
         row["confirmed"], row["confirmed_defaults"] = got.value[0], got.default_value[0]
-        print(f"{row['sequence']} {row['tracker']} {row['route']}: {got.line()}", flush=True)
+        print(f"{row['sequence']} {row['tracker']} {row['route']}: " + "; ".join(got.lines()), flush=True)
         out.with_suffix(".tmp").write_text("".join(json.dumps(r) + "\n" for r in rows))
         out.with_suffix(".tmp").replace(out)
 

@@ -45,7 +45,10 @@ def run(args) -> int:
     out = output_file(args.out, force, "--out", (".md",))
     scene_file = output_file(args.scene, args.force, "--scene", (".toml",))
     check_sensor(args.sensor)
-    work = estimate("advise", [(len(args.trackers), "trackers"), (args.trials + 2, "runs"), (len(args.seeds), "seeds")],
+    from mtt_sim.lab.confirm import CONTENDERS
+
+    runs = args.trials + CONTENDERS + 1  # the trials, then at most the contenders and the defaults on fresh seeds
+    work = estimate("advise", [(len(args.trackers), "trackers"), (runs, "runs"), (len(args.seeds), "seeds")],
                     [args.folder], {"sensor.model": "synthetic"})
     if dry_run(args, work + ", after the scene's fit"):
         return 0

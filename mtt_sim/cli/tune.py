@@ -38,8 +38,8 @@ def add(subparsers) -> None:
                    help="episode seeds per source: a count (3: seeds 0..2), a list or a range (default 1)")
     p.add_argument("--seed", type=integer(0), default=0, help="the sampler's seed: one seed, one study (default 0)")
     p.add_argument("--confirm", type=integer(0), default=0, metavar="N",
-                   help="then run the best spec and the defaults on N fresh seeds of the simulated sources, for a "
-                        "score the study's own seeds did not choose (default 0: none)")
+                   help="then run the study's best 3 specs and the defaults on N fresh seeds of the simulated sources, "
+                        "and keep the best there: a score the study's own seeds did not choose (default 0: none)")
     p.add_argument("--workers", type=integer(1), default=1, help="processes running a trial's episodes (default 1)")
     p.add_argument("--backend", choices=("local", "ray"), default="local",
                    help="local processes, or Ray tasks for a trial's episodes (the [ray] extra; --address for a cluster)")
@@ -75,8 +75,11 @@ def run(args) -> int:
     trials = [(args.trials, "trials"), (len(args.on), "sources"), (len(args.seeds), "seeds")]
     work = estimate("tune", trials, args.on, overrides)
     if args.confirm:
+        from mtt_sim.lab.confirm import CONTENDERS
+
         fresh = _fresh(args.on, overrides)
-        work += f", then the best and the defaults on {args.confirm} fresh seeds ({2 * args.confirm * fresh} episodes)"
+        work += (f", then its best {CONTENDERS} and the defaults on {args.confirm} fresh seeds (at most "
+                 f"{(CONTENDERS + 1) * args.confirm * fresh} episodes)")
     if dry_run(args, work):
         return 0
     announce(work)

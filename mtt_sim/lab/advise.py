@@ -95,8 +95,8 @@ def warnings(choices: Sequence[Choice], camera: str) -> list[str]:
                        f"{len(a.per_seed)} seeds to {a.tracker}): the scene cannot tell them apart; try both")
     if choices and choices[0].score < choices[0].default:
         first = choices[0]
-        out.append(f"{first.tracker}'s tuned spec scores below its defaults on the fresh seeds ({100 * first.score:.1f} "
-                   f"against {100 * first.default:.1f}): its study's gain did not hold; its defaults may do better")
+        out.append(f"{first.tracker}'s tuned spec scores below its defaults on the fresh seeds "
+                   f"({100 * first.score:.1f} against {100 * first.default:.1f}): its study's gain did not hold; its defaults may do better")
     line = routes.caution("scene", camera, choices[0].tracker if choices else routes.ANY)
     if line:
         out.append(line)

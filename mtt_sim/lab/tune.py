@@ -27,7 +27,7 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
-from mtt_sim.lab.confirm import Confirmation, confirm, fresh_seeds
+from mtt_sim.lab.confirm import CONTENDERS, Confirmation, confirm, fresh_seeds
 from mtt_sim.lab.experiment import episode_pool, run_tasks, score
 from mtt_sim.lab.study import (counted, default_study_name, definition, mark_interrupted, open_storage, open_study,
                                state)
@@ -97,8 +97,9 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
     `trials` finished trials (complete, pruned, or failed by their own error; fewer within `time_budget` seconds),
     TPE seeded by `seed`. `storage` (an Optuna URL such as sqlite:///study.db) keeps the study, which a later call
     resumes: by default it is named after the definition, and a `study_name` whose stored definition differs is
-    refused with a ValueError. With `confirm_seeds`, the best spec and the defaults then run on that many fresh seeds
-    of the simulated sources (`confirm`: the result's `confirmed`). `say` gets the lines worth telling a user (a
+    refused with a ValueError. With `confirm_seeds`, the study's best trials and the defaults then run on that many
+    fresh seeds of the simulated sources, and the best of those trials there is the result (`confirm`; the result's
+    `confirmed`). `say` gets the lines worth telling a user (a
     resumed study's counts, a failed trial).
     Returns the result and the Optuna study; on Ctrl-C raises `Interrupted` with the best so far."""
     import optuna
@@ -191,9 +192,14 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
         result = _result(study, name, fixed, wanted)
     if confirm_seeds:  # after the study, so Ctrl-C stops it at once; the study itself is finished and stored
         defaults = spec_of(name, {**fixed, **{k: spec.values[k] for k in space}})
+        contenders = contenders_of(study, result, wanted)
         try:
-            result.confirmed = confirm(result.spec, defaults, sources, wanted, fresh_seeds(seeds, confirm_seeds),
-                                       config, workers, backend, address)
+            result.confirmed = confirm([t.user_attrs["spec"] for t in contenders], defaults, sources, wanted,
+                                       fresh_seeds(seeds, confirm_seeds), config, workers, backend, address)
+            if result.confirmed:
+                kept = contenders[result.confirmed.kept]
+                result.spec, result.params = kept.user_attrs["spec"], dict(kept.params)
+                result.value = kept.values[0] if len(wanted) == 1 else list(kept.values)
         except KeyboardInterrupt:
             result.interrupted = True
             _note(result, study, trials, kept)
@@ -293,6 +299,22 @@ def _result(study, name: str, fixed: Mapping, wanted: list[Goal]) -> Result:
                   front=[{"spec": t.user_attrs["spec"], "value": scores(t)} for t in front] if len(wanted) > 1 else [])
 
 
+def contenders_of(study, result: Result, wanted: list[Goal]) -> list:
+    """The study's best trial (the result's) and the next best in the first metric: CONTENDERS in all, each spec
+    once."""
+    import optuna
+
+    done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
+    done.sort(key=lambda t: (-t.values[0] if wanted[0].maximize else t.values[0], t.number))
+    best = next(t for t in done if t.user_attrs["spec"] == result.spec)
+    out = {best.user_attrs["spec"]: best}
+    for t in done:
+        if len(out) == CONTENDERS:
+            break
+        out.setdefault(t.user_attrs["spec"], t)
+    return list(out.values())
+
+
 def best_trials(study, wanted: list[Goal], count: int = 5) -> list[dict]:
     """The `count` best finished trials in the first metric: number, values and parameters."""
     import optuna
@@ -312,14 +334,21 @@ def report(result: Result, study, count: int = 5) -> str:
     table += [f"| {' | '.join(cell(r.get(c, '')) for c in columns)} |" for r in rows]
     metric = ",".join(g.text for g in result.goals)
     lines = ["", *([f"study: {result.study}"] if result.study else []),
-             f"best{' so far' if result.interrupted else ''}: {result.spec}",
-             f"{metric}: {result.value} (defaults: {result.default_value})",
+             f"{_kept(result)}: {result.spec}",
+             f"{metric}: {result.value} (defaults: {result.default_value}){' on the study' * bool(result.confirmed)}",
              "trials: " + ", ".join(f"{n} {state}" for state, n in result.trials.items())]
     if result.confirmed:
-        lines.append(result.confirmed.line())
+        lines += result.confirmed.lines()
     if result.interrupted:
         lines.append(f"interrupted: {result.finished} of {result.wanted} trials finished")
     return "\n".join(table + lines)
+
+
+def _kept(result: Result) -> str:
+    """What the result's spec is: the study's best (so far), or the best of its best on fresh seeds."""
+    if result.confirmed:
+        return "kept (the best on fresh seeds, below)"
+    return "best so far" if result.interrupted else "best"
 
 
 def plot(study, wanted: list[Goal], path) -> None:
