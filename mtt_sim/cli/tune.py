@@ -140,7 +140,7 @@ def _fresh(sources: list[str], overrides: dict) -> int:
     if not count:
         raise UsageError("--confirm", "every source is a recorded sequence on its own detections, the same episode "
                                       "whatever the seed: there is nothing to confirm (fresh seeds need a scenario, "
-                                      "a scenario file or a twin, --config sensor.model=synthetic)")
+                                      "a scenario file or a sequence's twin, --detector synthetic)")
     return count
 
 
