@@ -87,3 +87,17 @@ def test_the_command_prints_the_fresh_scores_and_refuses_what_it_cannot_confirm(
     assert cli.main(["tune", "sort", "--on", str(folder), "--confirm", "2"]) == 2
     err = capsys.readouterr().err
     assert "--confirm" in err and "nothing to confirm" in err and len(err.strip().splitlines()) == 1
+
+
+def test_ctrl_c_during_the_confirmation_gives_the_studys_best_marked_interrupted(monkeypatch):
+    from mtt_sim.lab import confirm as confirming
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(confirming, "run_tasks", interrupted)
+    with pytest.raises(tune.Interrupted) as stop:
+        tune.tune("sort", ["crossing"], "HOTA", trials=3, config=SHORT, confirm_seeds=2)
+    plain, _ = tune.tune("sort", ["crossing"], "HOTA", trials=3, config=SHORT)
+    got = stop.value.result
+    assert got.interrupted and got.confirmed is None and got.spec == plain.spec and got.finished == 3
