@@ -334,7 +334,7 @@ def report(result: Result, study, count: int = 5) -> str:
     table += [f"| {' | '.join(cell(r.get(c, '')) for c in columns)} |" for r in rows]
     metric = ",".join(g.text for g in result.goals)
     lines = ["", *([f"study: {result.study}"] if result.study else []),
-             f"{_kept(result)}: {result.spec}",
+             f"{_label(result)}: {result.spec}",
              f"{metric}: {result.value} (defaults: {result.default_value}){' on the study' * bool(result.confirmed)}",
              "trials: " + ", ".join(f"{n} {state}" for state, n in result.trials.items())]
     if result.confirmed:
@@ -344,7 +344,7 @@ def report(result: Result, study, count: int = 5) -> str:
     return "\n".join(table + lines)
 
 
-def _kept(result: Result) -> str:
+def _label(result: Result) -> str:
     """What the result's spec is: the study's best (so far), or the best of its best on fresh seeds."""
     if result.confirmed:
         return "kept (the best on fresh seeds, below)"
