@@ -1,9 +1,11 @@
 """docs/experiments/fresh_contenders.py: the spec each way keeps, and the routes' figures, on hand-made rows."""
 
 import importlib.util
+import sys
 
 from helpers import EXPERIMENTS
 
+sys.path.append(str(EXPERIMENTS))  # it imports tune_sim_to_real, beside it
 spec = importlib.util.spec_from_file_location("fresh_contenders", EXPERIMENTS / "fresh_contenders.py")
 fresh_contenders = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(fresh_contenders)
@@ -27,3 +29,18 @@ def test_each_way_keeps_its_spec_and_the_figures_follow():
     assert lines[2] == "| study | -0.40 | 1 of 2 | 0 of 1 | 8.0 | 8.0 |"
     assert lines[3] == "| fresh | 0.35 | 0 of 2 | 0 of 1 | 8.0 | 8.0 |"
     assert lines[4] == "| fresh or defaults | 0.25 | 0 of 2 | 0 of 1 | 10.0 | 10.0 |"
+
+
+def test_the_twin_route_is_tabled_from_its_own_rows():
+    """The same rows as above but SORT's tuned on its twin: the twin's table is the scene's above, and the scene's
+    now has IOU alone."""
+    rows = [{"sequence": "A", "tracker": t, "route": r, "defaults": 0.40, "real": real, "confirmed_defaults": d}
+            for t, r, real, d in (("sort", "oracle", 0.50, None), ("iou", "oracle", 0.50, None),
+                                  ("sort", "twin", 0.30, 0.10), ("iou", "scene", 0.42, 0.70))]
+    tops = {("A", "sort"): [{"fresh": 0.50, "real": 0.30}, {"fresh": 0.60, "real": 0.45}],
+            ("A", "iou"): [{"fresh": 0.65, "real": 0.42}]}
+    twin = fresh_contenders.table(rows, tops, "twin").splitlines()
+    assert twin[2:] == ["| study | -1.00 | 1 of 1 | 0 of 1 | 20.0 | 20.0 |",
+                        "| fresh | 0.50 | 0 of 1 | 0 of 1 | 5.0 | 5.0 |",
+                        "| fresh or defaults | 0.50 | 0 of 1 | 0 of 1 | 5.0 | 5.0 |"]
+    assert fresh_contenders.table(rows, tops).splitlines()[2] == "| study | 0.20 | 0 of 1 | 0 of 1 | 8.0 | 8.0 |"

@@ -1,13 +1,15 @@
 """Does keeping the best of a study's best trials on fresh seeds pick specs that hold on real video?
 
-For each scene-route row of `tune_sim_to_real.py`'s rows file (its studies are seeded, so each is rerun as it was), the
-study's CONTENDERS best trials are scored on FRESH seeds 100-103 of the scene and on the real sequence; then the
-routes' figures (median share of the oracle's gain, losses of over a point, the picks) are printed three ways: the
-study's best (as before `tune --confirm`), the contender best on the fresh seeds (as `tune --confirm` keeps), and that
-or the defaults, whichever scores best on the fresh seeds (which needs the rows' "confirmed_defaults", from
-`tune_sim_to_real.py --confirm 4`). A sequence's pick is the tracker whose kept spec scores best on the fresh seeds.
+For each row of a simulated route (`--route`: the fitted scene, or the twin) in `tune_sim_to_real.py`'s rows file (its
+studies are seeded, so each is rerun as it was), the study's CONTENDERS best trials are scored on FRESH seeds 100-103
+of its source and on the real sequence; then the route's figures (median share of the oracle's gain, losses of over
+a point, the picks) are printed three ways: the study's best (as before `tune --confirm`), the contender best on the
+fresh seeds (as `tune --confirm` keeps), and that or the defaults, whichever scores best on the fresh seeds (which
+needs the rows' "confirmed_defaults", from `tune_sim_to_real.py --confirm 4`). A sequence's pick is the tracker whose
+kept spec scores best on the fresh seeds.
 
     python docs/experiments/fresh_contenders.py ../shared/data/mot15 rows.jsonl OUT.jsonl --trackers sort,ocsort
+    python docs/experiments/fresh_contenders.py ../shared/data/mot15 rows.jsonl TWIN.jsonl --route twin
     python docs/experiments/fresh_contenders.py ../shared/data/mot15 rows.jsonl OUT.jsonl --table
 """
 
@@ -21,15 +23,17 @@ from pathlib import Path
 from mtt_sim.lab.confirm import CONTENDERS
 from mtt_sim.lab.experiment import run_episode
 from mtt_sim.lab.tune import contenders_of, tune
+from tune_sim_to_real import source_of  # beside this file: the source each route tunes on
 
 FRESH = range(100, 104)
 REAL_SCORING = {"env.max_tracks": 4096}
 
 
-def contenders(data: Path, row: dict, scenes: Path) -> list[dict]:
-    """The row's study rerun; its contenders' study scores, mean HOTA on the FRESH seeds of the scene, and real HOTA."""
-    scene = str(scenes / f"scene_{row['sequence']}.toml")
-    result, study = tune(row["tracker"], [scene], "HOTA", row["trials"], range(row["seeds"]))
+def contenders(data: Path, row: dict, work: Path) -> list[dict]:
+    """The row's study rerun (`work`: tune_sim_to_real's folder of scenes and detectors); its contenders' study
+    scores, mean HOTA on the FRESH seeds of its source, and real HOTA."""
+    source, config = source_of(row["route"], data / row["sequence"], work)
+    result, study = tune(row["tracker"], [source], "HOTA", row["trials"], range(row["seeds"]), config)
     if result.spec != row["spec"]:
         raise RuntimeError(f"{row['sequence']} {row['tracker']}: the rerun study found {result.spec}, not "
                            f"{row['spec']}")
@@ -37,7 +41,7 @@ def contenders(data: Path, row: dict, scenes: Path) -> list[dict]:
     for t in contenders_of(study, result, result.goals):
         spec = t.user_attrs["spec"]
         out.append({"spec": spec, "value": t.values[0],
-                    "fresh": statistics.mean(run_episode(scene, spec, s)["metrics"]["HOTA"] for s in FRESH),
+                    "fresh": statistics.mean(run_episode(source, spec, s, config)["metrics"]["HOTA"] for s in FRESH),
                     "real": run_episode(str(data / row["sequence"]), spec, config=REAL_SCORING)["metrics"]["HOTA"]})
     return out
 
@@ -51,21 +55,21 @@ def chosen(row: dict, top: list[dict], how: str) -> tuple[float, float]:
     return pick["real"], pick["fresh"]
 
 
-def table(rows: list[dict], tops: dict) -> str:
-    """The routes' figures each way (see the module's docstring)."""
+def table(rows: list[dict], tops: dict, route: str = "scene") -> str:
+    """The route's figures each way (see the module's docstring)."""
     oracle = {(r["sequence"], r["tracker"]): r for r in rows if r["route"] == "oracle"}
-    scene = {(r["sequence"], r["tracker"]): r for r in rows if r["route"] == "scene" and
+    tuned = {(r["sequence"], r["tracker"]): r for r in rows if r["route"] == route and
              (r["sequence"], r["tracker"]) in tops}
     lines = ["| kept | median share | losses of over a point | picks within 2 points | median gap | largest gap |",
              "|---|---:|---:|---:|---:|---:|"]
     for how in ("study", "fresh", "fresh or defaults"):
-        got = {k: chosen(r, tops[k], how) for k, r in scene.items()}
-        gains = {k: 100 * (got[k][0] - r["defaults"]) for k, r in scene.items()}
-        best = {k: 100 * (oracle[k]["real"] - r["defaults"]) for k, r in scene.items()}
-        shares = [gains[k] / best[k] for k in scene if best[k] >= 1]
+        got = {k: chosen(r, tops[k], how) for k, r in tuned.items()}
+        gains = {k: 100 * (got[k][0] - r["defaults"]) for k, r in tuned.items()}
+        best = {k: 100 * (oracle[k]["real"] - r["defaults"]) for k, r in tuned.items()}
+        shares = [gains[k] / best[k] for k in tuned if best[k] >= 1]
         gaps = []
-        for s in sorted({k[0] for k in scene}):
-            mine = [k for k in scene if k[0] == s]
+        for s in sorted({k[0] for k in tuned}):
+            mine = [k for k in tuned if k[0] == s]
             top = max(mine, key=lambda k: got[k][1])
             gaps.append(100 * (max(oracle[k]["real"] for k in mine) - got[top][0]))
         lines.append(f"| {how} | {statistics.median(shares):.2f} | {sum(g < -1 for g in gains.values())} of "
@@ -77,8 +81,10 @@ def table(rows: list[dict], tops: dict) -> str:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("data", help="a folder of MOTChallenge sequence folders")
-    p.add_argument("rows", help="tune_sim_to_real.py's rows file (its scenes in the folder of the same name)")
+    p.add_argument("rows", help="tune_sim_to_real.py's rows file (its scenes and detectors in the folder of the "
+                                "same name)")
     p.add_argument("out", help="the contenders, one JSON object a study (a rerun skips those there)")
+    p.add_argument("--route", default="scene", choices=("scene", "twin"), help="the simulated route's rows")
     p.add_argument("--trackers", default="", help="only these trackers' studies (comma-separated; default all)")
     p.add_argument("--table", action="store_true", help="only print the table of OUT")
     args = p.parse_args()
@@ -89,14 +95,14 @@ def main() -> None:
     wanted = set(filter(None, args.trackers.split(",")))
     for row in rows if not args.table else ():
         key = (row["sequence"], row["tracker"])
-        if row["route"] != "scene" or key in tops or (wanted and row["tracker"] not in wanted):
+        if row["route"] != args.route or key in tops or (wanted and row["tracker"] not in wanted):
             continue
         tops[key] = contenders(Path(args.data), row, Path(args.rows).with_suffix(""))
         with out.open("a") as f:
             f.write(json.dumps({"sequence": key[0], "tracker": key[1], "top": tops[key]}) + "\n")
         print(key, [(round(c["fresh"], 3), round(c["real"], 3)) for c in tops[key]], flush=True)
     print(f"{CONTENDERS} contenders a study, fresh seeds {FRESH.start}-{FRESH.stop - 1}:\n")
-    print(table(rows, tops))
+    print(table(rows, tops, args.route))
 
 
 if __name__ == "__main__":

@@ -100,7 +100,7 @@ def measure(args, out: Path) -> None:
                 if route == "oracle":
                     result = tune(spec, [str(folder)], args.metric, args.trials)[0]
                 elif route in ("twin", "scene"):
-                    source, config = _source(route, folder, work)
+                    source, config = source_of(route, folder, work)
                     result = tune(spec, [source], args.metric, args.trials, seeds, config)[0]
                 else:
                     result = generic[spec, rate]
@@ -123,7 +123,7 @@ def confirm_rows(args, out: Path) -> None:
         if row["route"] == "oracle" or "confirmed" in row:
             continue
         folder = Path(args.data) / row["sequence"]
-        source, config = _source(row["route"], folder, work)
+        source, config = source_of(row["route"], folder, work)
         seeds = fresh_seeds(range(FRESH), args.confirm)
         got = confirm([row["spec"]], row["tracker"], [source], goals(args.metric), seeds, config, args.workers)
         row["confirmed"], row["confirmed_defaults"] = got.value[0], got.default_value[0]
@@ -132,7 +132,7 @@ def confirm_rows(args, out: Path) -> None:
         out.with_suffix(".tmp").replace(out)
 
 
-def _source(route: str, folder: Path, work: Path) -> tuple[str, dict | None]:
+def source_of(route: str, folder: Path, work: Path) -> tuple[str, dict | None]:
     """The source a route tunes on for the sequence `folder` and its config (what `measure` tunes on)."""
     if route == "twin":
         sensor = tomllib.loads((work / f"fitted_without_{folder.name}.toml").read_text())["sensor"]
