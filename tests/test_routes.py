@@ -88,6 +88,11 @@ def test_tune_warns_once_per_route_that_did_not_hold(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.count("warning: on the shared sequences (8 MOT15 sequences), specs of the measured trackers (sort was "
                      "not measured) tuned on a generic scenario kept a median 0.20") == 1
+    assert err.count("note: a study's best is flattered by its own seeds; --confirm 4") == 1
+    assert cli.main(["tune", "sort", "--on", "crossing", "--trials", "2", "--json", "--confirm", "1",
+                     "--config", "env.max_steps=10"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: on the shared sequences" in err and "--confirm 4" not in err  # asked for already
 
 
 def test_a_scene_that_moves_or_goes_forward_is_a_walking_camera():
