@@ -41,11 +41,11 @@ def test_ranks_the_candidates_with_their_tuned_specs(camera, tmp_path, capsys):
     scene = str(tmp_path / "scene.toml")
     for c in choices:
         trackers.make(c["spec"])                                            # ready for --tracker
-        assert len(c["per_seed"]) == 2 and c["score"] == pytest.approx(sum(c["per_seed"]) / 2)
-        # scored on fresh seeds, 2 and 3 (the study ran 0 and 1): the spec's and the defaults' own episodes
-        assert list(c["per_seed"]) == [run_episode(scene, c["spec"], s)["metrics"]["HOTA"] for s in (2, 3)]
+        assert len(c["per_seed"]) == 4 and c["score"] == pytest.approx(sum(c["per_seed"]) / 4)
+        # scored on fresh seeds, at least 4: 2 to 5 (the study ran 0 and 1): the spec's and the defaults' own episodes
+        assert list(c["per_seed"]) == [run_episode(scene, c["spec"], s)["metrics"]["HOTA"] for s in (2, 3, 4, 5)]
         assert c["default"] == pytest.approx(sum(run_episode(scene, c["tracker"], s)["metrics"]["HOTA"]
-                                                 for s in (2, 3)) / 2)
+                                                 for s in (2, 3, 4, 5)) / 4)
     assert got["camera"] == "still" and (tmp_path / "scene.toml").is_file()
 
 
@@ -70,6 +70,15 @@ def test_a_resumed_run_tunes_only_what_is_missing(camera, tmp_path, monkeypatch)
     calls.clear(), stop_at.clear()
     assert advice(camera, tmp_path, "--out", str(out), "--resume") == 0
     assert calls == ["iou"] and out.read_text() == first and not journal.exists()  # one seed, one advice
+
+
+def test_a_trial_runs_about_as_many_frames_on_a_short_scene_as_on_a_long_one(camera, capsys):
+    assert advise.seeds_for(71) == list(range(8)) and advise.seeds_for(179) == [0, 1, 2]
+    assert advise.seeds_for(1000) == [0] and advise.seeds_for(25, frames=100) == [0, 1, 2, 3]
+    folder, sensor = camera  # 25 frames: 100 frames a trial is 4 seeds; 2 trials, then 4 specs on 4 fresh seeds
+    assert cli.main(["advise", str(folder), "--sensor", str(sensor), "--trackers", "sort", "--trials", "2",
+                     "--frames", "100", "--dry-run"]) == 0
+    assert capsys.readouterr().out.startswith("advise: 1 tracker x 24 episodes = 24 episodes, about 600 frames")
 
 
 def test_two_trackers_the_seeds_cannot_tell_apart_are_said_to_be():
@@ -108,6 +117,8 @@ def test_the_routes_record_on_real_cameras_of_the_kind_is_told(monkeypatch):
     (["--metric", "HOTA,-IDSW"], "advise ranks by one metric"),
     (["--trackers", "sort,nosuch"], "nosuch"),
     (["--seeds", "0"], "--seeds"),
+    (["--frames", "0"], "--frames"),
+    (["--frames", "300", "--seeds", "2"], "argument --seeds: not allowed with argument --frames"),
 ])
 def test_bad_arguments_get_one_line_before_any_work(camera, capsys, extra, message):
     folder, sensor = camera

@@ -273,7 +273,7 @@ DRY_RUNS = [
     (["fit-scene", "OK", "--sensor", "SENSOR", "--out", "s.toml"],
      "fit-scene: 3 runs (the sequence linked, then the scene's seeds) = 3 episodes, about 15 frames"),
     (["advise", "OK", "--sensor", "SENSOR", "--trackers", "sort,iou", "--trials", "3", "--seeds", "2"],
-     "advise: 2 trackers x 7 runs x 2 seeds = 28 episodes, about 140 frames, after the scene's fit"),
+     "advise: 2 trackers x 22 episodes = 44 episodes, about 220 frames, after the scene's fit"),  # 3 x 2 + 4 x 4
     (["perf", "--repeats", "2", "--sections", "env,jpda"], "perf: 2 tables x 2 repeats = 4 measurements"),
     (["learn-reid", "--seeds", "2", "--frames", "30"], "learn-reid: 2 seeds = 2 episodes, about 60 frames"),
     (["export", "crossing", "--out", "seq", "--steps", "7"], "export: 1 episode, about 7 frames"),

@@ -10,14 +10,15 @@ import sys
 from pathlib import Path
 
 from mtt_sim.cli import resuming
-from mtt_sim.cli.arguments import (FORCE_HELP, UsageError, add_dry_run, announce, check_sensor, dry_run, estimate,
-                                   integer, output_file, parse_seeds, replaced, tracker_specs)
+from mtt_sim.cli.arguments import (FORCE_HELP, UsageError, add_dry_run, announce, check_sensor, dry_run,
+                                   episode_frames, estimate, integer, output_file, parse_seeds, replaced,
+                                   tracker_specs)
 from mtt_sim.cli.fit_scene import add_camera
 from mtt_sim.cli.tune import metric_goals
 
 
 def add(subparsers) -> None:
-    from mtt_sim.lab.advise import CANDIDATES
+    from mtt_sim.lab.advise import CANDIDATES, FRAMES
 
     p = subparsers.add_parser("advise", help="for a camera without labels: fit its scene, tune each candidate tracker "
                                              "on it and rank them, with the tuned specs and the simulator's confidence")
@@ -26,8 +27,11 @@ def add(subparsers) -> None:
                    help=f"the candidates, each tuned from its spec (default {','.join(CANDIDATES)})")
     p.add_argument("--metric", type=metric_goals, default="HOTA", help="what to rank by and tune for (default HOTA)")
     p.add_argument("--trials", type=integer(1), default=20, help="trials a candidate, the defaults' first (default 20)")
-    p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("4"),
-                   help="the scene's episode seeds: a count, a list or a range (default 4)")
+    episodes = p.add_mutually_exclusive_group()
+    episodes.add_argument("--frames", type=integer(1), default=FRAMES,
+                          help=f"about this many frames a trial: the scene runs as many seeds (default {FRAMES})")
+    episodes.add_argument("--seeds", type=parse_seeds,
+                          help="the scene's episode seeds instead: a count, a list or a range")
     p.add_argument("--seed", type=integer(0), default=0, help="the samplers' seed: one seed, one advice (default 0)")
     p.add_argument("--scene", help="also write the fitted scene (.toml)")
     p.add_argument("--out", help="write the ranking as Markdown (.md); its journal beside it lets --resume go on")
@@ -45,11 +49,14 @@ def run(args) -> int:
     out = output_file(args.out, force, "--out", (".md",))
     scene_file = output_file(args.scene, args.force, "--scene", (".toml",))
     check_sensor(args.sensor)
+    from mtt_sim.lab.advise import FRESH, seeds_for
     from mtt_sim.lab.confirm import CONTENDERS
 
-    runs = args.trials + CONTENDERS + 1  # the trials, then at most the contenders and the defaults on fresh seeds
-    work = estimate("advise", [(len(args.trackers), "trackers"), (runs, "runs"), (len(args.seeds), "seeds")],
-                    [args.folder], {"sensor.model": "synthetic"})
+    synthetic = {"sensor.model": "synthetic"}
+    args.seeds = args.seeds or seeds_for(episode_frames(args.folder, synthetic), args.frames)
+    # the trials, then at most the contenders and the defaults on the fresh seeds
+    episodes = args.trials * len(args.seeds) + (CONTENDERS + 1) * max(FRESH, len(args.seeds))
+    work = estimate("advise", [(len(args.trackers), "trackers"), (episodes, "episodes")], [args.folder], synthetic)
     if dry_run(args, work + ", after the scene's fit"):
         return 0
     announce(work)
@@ -58,7 +65,7 @@ def run(args) -> int:
 
     definition = {"folder": str(Path(args.folder).resolve()), "sensor": Path(args.sensor).read_text(),
                   "trackers": args.trackers, "metric": args.metric, "trials": args.trials, "seeds": args.seeds,
-                  "seed": args.seed, "scored on": "fresh seeds"}
+                  "seed": args.seed, "scored on": f"fresh seeds, at least {FRESH}"}
     journal = resuming.journal(out, definition, args.resume, "candidates") if out else None
     say = (lambda line: print(line, file=sys.stderr, flush=True))
     path = scene_file or Path(out or ".").with_name(f".advise_{Path(args.folder).name}_scene.toml")
@@ -103,6 +110,7 @@ def _report(args, choices, camera: str) -> str:
 
     lines = [f"# Trackers for {Path(args.folder).name} ({camera} camera), ranked on its fitted scene", "",
              advise.table(choices, args.metric), ""]
-    lines += [f"- warning: {w}" for w in advise.warnings(choices, camera)]
-    lines += ["", f"Run the first: mtt-sim run {shlex.quote(args.folder)} --tracker {shlex.quote(choices[0].spec)}"]
+    warnings = [f"- warning: {w}" for w in advise.warnings(choices, camera)]
+    lines += warnings + [""] * bool(warnings)
+    lines += [f"Run the first: mtt-sim run {shlex.quote(args.folder)} --tracker {shlex.quote(choices[0].spec)}"]
     return "\n".join(lines)

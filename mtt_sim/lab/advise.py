@@ -19,6 +19,8 @@ from typing import Callable, Sequence
 from mtt_sim.lab import routes
 
 CANDIDATES = ("sort", "bytetrack", "ocsort", "iou", "gmphd")  # fast and sound on every shared sequence
+FRAMES = 600  # about this many frames a trial, whatever the scene's length (`seeds_for`)
+FRESH = 4  # the fewest fresh seeds a candidate is ranked on
 
 
 @dataclass(frozen=True)
@@ -40,12 +42,19 @@ class Choice:
         return statistics.stdev(self.per_seed) if len(self.per_seed) > 1 else 0.0
 
 
+def seeds_for(length: int, frames: int = FRAMES) -> list[int]:
+    """The seeds of a study on a `length`-frame scene: as many as make about `frames` frames a trial, at least one.
+    A short scene's trial is otherwise a few noisy frames: on the shared MOT15 sequences the label-free route's worst
+    losses were the shortest sequences' studies, and went with about 600 frames a trial (docs/tuning.md)."""
+    return list(range(max(1, round(frames / length))))
+
+
 def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HOTA", trials: int = 20,
            seeds: Sequence[int] = (0, 1, 2, 3), seed: int = 0, done: Callable[[str], Choice | None] | None = None,
            finished: Callable[[str, Choice], None] | None = None,
            say: Callable[[str], None] | None = None) -> list[Choice]:
     """Each candidate spec tuned on the scene file `scene` (`trials` trials of `seeds`, TPE seeded by `seed`), then
-    run with its defaults on as many fresh seeds; best first on those. `done(spec)` gives a candidate finished earlier
+    run with its defaults on as many fresh seeds, at least FRESH; best first on those. `done(spec)` gives a candidate finished earlier
     (a resumed run), `finished` is told each one as it finishes, `say` the progress."""
     from mtt_sim.lab import tune
     from mtt_sim.trackers import TrackerSpec
@@ -56,7 +65,7 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
         choice = done(spec) if done else None
         if choice is None:
             say(f"advise: tuning {spec} ({k} of {len(candidates)}), {trials} trials x {len(seeds)} seeds")
-            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed, confirm_seeds=len(seeds))
+            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed, confirm_seeds=max(FRESH, len(seeds)))
             fresh = result.confirmed
             choice = Choice(TrackerSpec.of(spec).registered, result.spec, fresh.per_seed, fresh.default_value[0])
             if finished:
