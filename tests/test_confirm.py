@@ -49,6 +49,7 @@ def test_a_confirmed_study_keeps_the_best_of_its_best_trials_on_seeds_it_never_r
     kept = next(t for t in study.trials if t.user_attrs.get("spec") == result.spec)
     assert result.value == kept.values[0] and result.params == kept.params  # its study's score, as before
     assert result.as_dict()["confirmed"]["seeds"] == [2, 3] and c.holds == (mean[c.spec] > mean[start])
+    assert result.kept == 0 and result.finished == 6  # no trial kept from an earlier run: a count, not the kept spec
 
 
 def test_the_kept_contender_and_the_verdict_follow_each_metrics_direction():

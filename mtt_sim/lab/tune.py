@@ -197,9 +197,9 @@ def tune(spec: str, sources: Sequence[str], metric: str = "HOTA", trials: int = 
             result.confirmed = confirm([t.user_attrs["spec"] for t in contenders], defaults, sources, wanted,
                                        fresh_seeds(seeds, confirm_seeds), config, workers, backend, address)
             if result.confirmed:
-                kept = contenders[result.confirmed.kept]
-                result.spec, result.params = kept.user_attrs["spec"], dict(kept.params)
-                result.value = kept.values[0] if len(wanted) == 1 else list(kept.values)
+                chosen = contenders[result.confirmed.kept]
+                result.spec, result.params = chosen.user_attrs["spec"], dict(chosen.params)
+                result.value = chosen.values[0] if len(wanted) == 1 else list(chosen.values)
         except KeyboardInterrupt:
             result.interrupted = True
             _note(result, study, trials, kept)
