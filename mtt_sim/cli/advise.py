@@ -49,13 +49,13 @@ def run(args) -> int:
     out = output_file(args.out, force, "--out", (".md",))
     scene_file = output_file(args.scene, args.force, "--scene", (".toml",))
     check_sensor(args.sensor)
-    from mtt_sim.lab.advise import FRESH, seeds_for
+    from mtt_sim.lab.advise import FRESH, fresh_count, seeds_for
     from mtt_sim.lab.confirm import CONTENDERS
 
     synthetic = {"sensor.model": "synthetic"}
     args.seeds = args.seeds or seeds_for(episode_frames(args.folder, synthetic), args.frames)
     # the trials, then at most the contenders and the defaults on the fresh seeds
-    episodes = args.trials * len(args.seeds) + (CONTENDERS + 1) * max(FRESH, len(args.seeds))
+    episodes = args.trials * len(args.seeds) + (CONTENDERS + 1) * fresh_count(args.seeds)
     work = estimate("advise", [(len(args.trackers), "trackers"), (episodes, "episodes")], [args.folder], synthetic)
     if dry_run(args, work + ", after the scene's fit"):
         return 0

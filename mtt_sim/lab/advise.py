@@ -49,13 +49,19 @@ def seeds_for(length: int, frames: int = FRAMES) -> list[int]:
     return list(range(max(1, round(frames / length))))
 
 
+def fresh_count(seeds: Sequence[int]) -> int:
+    """How many fresh seeds a candidate tuned on `seeds` is ranked on: as many, at least FRESH (one seed of a long
+    scene would give no spread)."""
+    return max(FRESH, len(seeds))
+
+
 def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HOTA", trials: int = 20,
            seeds: Sequence[int] = (0, 1, 2, 3), seed: int = 0, done: Callable[[str], Choice | None] | None = None,
            finished: Callable[[str, Choice], None] | None = None,
            say: Callable[[str], None] | None = None) -> list[Choice]:
     """Each candidate spec tuned on the scene file `scene` (`trials` trials of `seeds`, TPE seeded by `seed`), then
-    run with its defaults on as many fresh seeds, at least FRESH; best first on those. `done(spec)` gives a candidate finished earlier
-    (a resumed run), `finished` is told each one as it finishes, `say` the progress."""
+    run with its defaults on `fresh_count(seeds)` fresh seeds; best first on those. `done(spec)` gives a candidate
+    finished earlier (a resumed run), `finished` is told each one as it finishes, `say` the progress."""
     from mtt_sim.lab import tune
     from mtt_sim.trackers import TrackerSpec
 
@@ -65,7 +71,7 @@ def advise(scene: str, candidates: Sequence[str] = CANDIDATES, metric: str = "HO
         choice = done(spec) if done else None
         if choice is None:
             say(f"advise: tuning {spec} ({k} of {len(candidates)}), {trials} trials x {len(seeds)} seeds")
-            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed, confirm_seeds=max(FRESH, len(seeds)))
+            result, _ = tune.tune(spec, [scene], metric, trials, seeds, seed=seed, confirm_seeds=fresh_count(seeds))
             fresh = result.confirmed
             choice = Choice(TrackerSpec.of(spec).registered, result.spec, fresh.per_seed, fresh.default_value[0])
             if finished:
@@ -105,7 +111,8 @@ def warnings(choices: Sequence[Choice], camera: str) -> list[str]:
     if choices and choices[0].score < choices[0].default:
         first = choices[0]
         out.append(f"{first.tracker}'s tuned spec scores below its defaults on the fresh seeds "
-                   f"({100 * first.score:.1f} against {100 * first.default:.1f}): its study's gain did not hold; its defaults may do better")
+                   f"({100 * first.score:.1f} against {100 * first.default:.1f}): its study's gain did not hold; "
+                   "its defaults may do better")
     line = routes.caution("scene", camera, choices[0].tracker if choices else routes.ANY)
     if line:
         out.append(line)
