@@ -23,7 +23,7 @@ def test_a_spec_reporting_more_tracks_than_the_action_rows_is_scored_not_stopped
                             size=(400, 400))
     with pytest.raises(ValueError, match="256 rows"):
         run_episode(str(folder), "echo")
-    assert tune_sim_to_real._real(folder, "echo", "HOTA") == pytest.approx(math.sqrt(1 / 300))
+    assert tune_sim_to_real.real_score(folder, "echo", "HOTA") == pytest.approx(math.sqrt(1 / 300))
 
 
 def _row(tracker, route, real, **more):

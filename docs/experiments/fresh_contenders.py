@@ -23,10 +23,10 @@ from pathlib import Path
 from mtt_sim.lab.confirm import CONTENDERS
 from mtt_sim.lab.experiment import run_episode
 from mtt_sim.lab.tune import contenders_of, tune
-from tune_sim_to_real import source_of  # beside this file: the source each route tunes on
+from tune_sim_to_real import FRESH as FIRST_FRESH  # beside this file, as the routes' sources and real scoring
+from tune_sim_to_real import real_score, source_of
 
-FRESH = range(100, 104)
-REAL_SCORING = {"env.max_tracks": 4096}
+FRESH = range(FIRST_FRESH, FIRST_FRESH + 4)  # the seeds tune_sim_to_real.py --confirm 4 scores the rows on
 
 
 def contenders(data: Path, row: dict, work: Path) -> list[dict]:
@@ -42,7 +42,7 @@ def contenders(data: Path, row: dict, work: Path) -> list[dict]:
         spec = t.user_attrs["spec"]
         out.append({"spec": spec, "value": t.values[0],
                     "fresh": statistics.mean(run_episode(source, spec, s, config)["metrics"]["HOTA"] for s in FRESH),
-                    "real": run_episode(str(data / row["sequence"]), spec, config=REAL_SCORING)["metrics"]["HOTA"]})
+                    "real": real_score(data / row["sequence"], spec, "HOTA")})
     return out
 
 

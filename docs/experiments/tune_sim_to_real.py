@@ -104,9 +104,9 @@ def measure(args, out: Path) -> None:
                     result = tune(spec, [source], args.metric, args.trials, seeds, config)[0]
                 else:
                     result = generic[spec, rate]
-                defaults = defaults if defaults is not None else _real(folder, spec, args.metric)
+                defaults = defaults if defaults is not None else real_score(folder, spec, args.metric)
                 row = {"sequence": folder.name, "tracker": spec, "route": route, "defaults": defaults,
-                       "tuned_value": result.value, "real": _real(folder, result.spec, args.metric),
+                       "tuned_value": result.value, "real": real_score(folder, result.spec, args.metric),
                        "spec": result.spec, "trials": args.trials, "seeds": len(seeds)}
                 with out.open("a") as f:
                     f.write(json.dumps(row) + "\n")
@@ -152,7 +152,7 @@ def _lines(path: Path) -> list[str]:
     return path.read_text().splitlines() if path.is_file() else []
 
 
-def _real(folder: Path, spec: str, metric: str) -> float:
+def real_score(folder: Path, spec: str, metric: str) -> float:
     """The spec's score on the real sequence. The action space is widened: a spec tuned in simulation may report more
     tracks on real video than the env's default 256 rows, and that is a poor score, not a reason to stop the run."""
     return run_episode(str(folder), spec, config=REAL_SCORING)["metrics"][metric]

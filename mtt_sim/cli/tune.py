@@ -121,8 +121,8 @@ def run(args) -> int:
 
 def _caution(spec: str, sources: list[str], overrides: dict, confirm: int) -> None:
     """Warn, once per route, where tuning the tracker of `spec` in simulation has not held on real video
-    (`routes.RECORD`), and name --confirm where it is not given: on the shared sequences it took the worst losses
-    away (docs/tuning.md, "Fresh seeds")."""
+    (`routes.RECORD`), and name --confirm where it is not given: on the shared sequences it took the scene route's
+    worst loss away (docs/tuning.md, "Fresh seeds")."""
     from mtt_sim.lab import routes
     from mtt_sim.trackers import TrackerSpec
 
